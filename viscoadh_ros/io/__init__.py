@@ -1,0 +1,1 @@
+"""File adapters: CSV histories, MCAP recording and reading of ROS 2 bags."""
