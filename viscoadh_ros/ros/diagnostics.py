@@ -1,0 +1,111 @@
+"""/diagnostics for the node: per contact step time, command counters, model, validity.
+
+``diagnostic_updater`` is not on PyPI, so the node builds its ``DiagnosticArray`` here: one
+``DiagnosticStatus`` per contact, named ``viscoadh: <id>``, published at about 1 Hz.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
+
+from viscoadh_ros.ros.conversions import ns_to_stamp
+
+
+@dataclass
+class StepTimer:
+    """Wall time of the simulator steps over the current diagnostics window, s."""
+
+    count: int = 0
+    total: float = 0.0
+    maximum: float = 0.0
+
+    def add(self, seconds: float) -> None:
+        """Account one step that took ``seconds``."""
+        self.count += 1
+        self.total += seconds
+        self.maximum = max(self.maximum, seconds)
+
+    def take(self) -> tuple[int, float, float]:
+        """(steps, mean s, max s) of the window, and start a new window."""
+        window = (
+            self.count,
+            self.total / self.count if self.count else 0.0,
+            self.maximum,
+        )
+        self.count, self.total, self.maximum = 0, 0.0, 0.0
+        return window
+
+
+@dataclass
+class ContactCounters:
+    """What one contact has seen since start; updated under the contact's lock."""
+
+    commands_received: int = 0
+    commands_rejected: int = 0
+    requests_rejected: int = 0
+    rejections_in_window: int = 0
+    last_rejection: str = ""
+    steps: StepTimer = field(default_factory=StepTimer)
+
+    def reject(self, reason: str, *, command: bool) -> None:
+        """Count one rejected command (``command=True``) or service request."""
+        if command:
+            self.commands_rejected += 1
+        else:
+            self.requests_rejected += 1
+        self.rejections_in_window += 1
+        self.last_rejection = reason
+
+
+def contact_status(
+    contact_id: str,
+    counters: ContactCounters,
+    *,
+    model: str,
+    scale_separation_ok: bool,
+    in_contact: bool,
+) -> DiagnosticStatus:
+    """The status of one contact; takes (and resets) the step-time and rejection windows.
+
+    Level WARN when the energy criterion's scale separation does not hold or something was
+    rejected since the last report, else OK.
+    """
+    steps, mean, maximum = counters.steps.take()
+    problems = []
+    if not scale_separation_ok:
+        problems.append("scale separation of the energy criterion violated")
+    if counters.rejections_in_window:
+        problems.append(
+            f"{counters.rejections_in_window} rejected (last: {counters.last_rejection})"
+        )
+    counters.rejections_in_window = 0
+    values = {
+        "model": model,
+        "in_contact": str(in_contact),
+        "scale_separation_ok": str(scale_separation_ok),
+        "steps_in_window": str(steps),
+        "step_time_mean_us": f"{mean * 1e6:.1f}",
+        "step_time_max_us": f"{maximum * 1e6:.1f}",
+        "commands_received": str(counters.commands_received),
+        "commands_rejected": str(counters.commands_rejected),
+        "requests_rejected": str(counters.requests_rejected),
+        "last_rejection": counters.last_rejection,
+    }
+    return DiagnosticStatus(
+        level=DiagnosticStatus.WARN if problems else DiagnosticStatus.OK,
+        name=f"viscoadh: {contact_id}",
+        hardware_id=contact_id,
+        message="; ".join(problems) if problems else "OK",
+        values=[KeyValue(key=k, value=v) for k, v in values.items()],
+    )
+
+
+def diagnostic_array(
+    statuses: list[DiagnosticStatus], *, stamp_ns: int
+) -> DiagnosticArray:
+    """The /diagnostics message holding ``statuses``, stamped on the node clock."""
+    msg = DiagnosticArray(status=statuses)
+    msg.header.stamp = ns_to_stamp(stamp_ns)
+    return msg
