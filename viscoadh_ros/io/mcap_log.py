@@ -79,12 +79,12 @@ class _Item:
 _STOP = object()
 
 
-def _plain(value: Any) -> Any:
+def plain(value: Any) -> Any:
     """Mappings and tuples as plain dicts and lists, so ``yaml.safe_dump`` takes them."""
     if isinstance(value, Mapping):
-        return {str(k): _plain(v) for k, v in value.items()}
+        return {str(k): plain(v) for k, v in value.items()}
     if isinstance(value, (list, tuple)):
-        return [_plain(v) for v in value]
+        return [plain(v) for v in value]
     return value
 
 
@@ -192,7 +192,7 @@ class McapRecorder:
         self._max_duration_ns = int(max_duration * 1e9)
         self._qos = dict(qos or {})
         self._metadata = {
-            SCENE_KEY: yaml.safe_dump(_plain(scene), sort_keys=False) if scene is not None else "",
+            SCENE_KEY: yaml.safe_dump(plain(scene), sort_keys=False) if scene is not None else "",
             VERSION_KEY: __version__,
         }
         self._queue: queue.Queue[Any] = queue.Queue(maxsize=queue_size)

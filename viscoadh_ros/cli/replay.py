@@ -1,0 +1,118 @@
+"""`viscoadh replay BAG -o OUT.mcap`: run the model over a recorded experiment, compare forces.
+
+OUT holds the model's ``<contact>/state`` (ContactState) and ``<contact>/wrench``
+(WrenchStamped) on the input stamps, plus the scene, so it can be plotted or replayed again.
+The summary (RMSE, max error, pull-off forces, speed) is printed and, with ``--json``, written.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+from viscoadh_ros.core.config import SceneConfig
+from viscoadh_ros.core.errors import InputError
+from viscoadh_ros.experiment import Experiment, ModelRun, choose_contact, compare, load_experiment, run_model
+from viscoadh_ros.io.bag import Bag
+
+
+def add_input_arguments(parser: argparse.ArgumentParser) -> None:
+    """Options that choose the recorded experiment (shared by replay and fit)."""
+    parser.add_argument("bag", type=Path, help="an .mcap file or a rosbag2 folder")
+    parser.add_argument("--scene", type=Path, help="scene YAML (default: the one stored in BAG by the node)")
+    parser.add_argument("--contact", help="contact id in the scene (default: the only one)")
+    parser.add_argument("--depth-topic", help="input topic: IndentationCommand, Float64 depth (m), "
+                        "or PointStamped/PoseStamped whose z is the depth (m)")
+    parser.add_argument("--force-topic", help="measured force: WrenchStamped (force.z, N) or Float64 (N), "
+                        "> 0 compressive")
+    parser.add_argument("--flip-force", action="store_true",
+                        help="negate the measured force (load cells that read tension positive)")
+    parser.add_argument("--recover", action="store_true",
+                        help="read unfinished (truncated) files up to their last complete chunk")
+
+
+def open_experiment(args: argparse.Namespace) -> tuple[Bag, SceneConfig, Experiment]:
+    """The bag, scene and experiment the shared options name; InputError when unusable."""
+    bag = Bag(args.bag, recover=args.recover)
+    for path in bag.truncated:
+        print(f"viscoadh: warning: {path} is unfinished; using its complete chunks", file=sys.stderr)
+    if args.scene is not None:
+        scene = SceneConfig.from_yaml(args.scene)
+    else:
+        stored = bag.scene()
+        if stored is None:
+            raise InputError(f"{str(args.bag)!r} stores no scene (not a log of our node); pass --scene")
+        scene = SceneConfig.from_dict(stored)
+    experiment = load_experiment(
+        bag,
+        input_topic=args.depth_topic,
+        force_topic=args.force_topic,
+        contact=args.contact,
+        flip_force=args.flip_force,
+    )
+    if experiment.force_topic is None:
+        raise InputError(
+            f"no measured force in {str(args.bag)!r}: record a WrenchStamped or name a Float64 "
+            f"force with --force-topic (topics: {bag.topics})"
+        )
+    return bag, scene, experiment
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    add_input_arguments(parser)
+    parser.add_argument("-o", "--output", type=Path, required=True, help="output .mcap file")
+    parser.add_argument("--json", type=Path, help="also write the summary to this JSON file")
+
+
+def main(args: argparse.Namespace) -> int:
+    if args.output.suffix != ".mcap":
+        raise InputError(f"--output must be an .mcap file (got {str(args.output)!r})")
+    _, scene, experiment = open_experiment(args)
+    contact = choose_contact(scene, args.contact, experiment.input_topic)
+
+    from tqdm import tqdm  # progress only on a terminal (tqdm disables itself otherwise)
+
+    events = experiment.input_ns.size + experiment.measured_ns.size
+    with tqdm(total=events, unit="step", file=sys.stderr, disable=None, leave=False) as bar:
+        run = run_model(contact, experiment, progress=bar.update)
+    summary = compare(experiment, run)
+    _write_output(args.output, scene, contact.id, experiment, run)
+
+    result = {"bag": str(args.bag), "contact": contact.id, "input_topic": experiment.input_topic,
+              "force_topic": experiment.force_topic, "output": str(args.output), **summary.as_dict()}
+    pull = lambda f: "none (never tensile)" if f is None else f"{f:.6g} N"  # noqa: E731
+    print(
+        f"replayed {experiment.input_ns.size} inputs of {contact.id} over {experiment.duration:.3f} s "
+        f"at {summary.speed:.3g}x real time\n"
+        f"force error vs {experiment.force_topic}: RMSE {summary.rmse:.6g} N, max {summary.max_error:.6g} N "
+        f"({summary.samples} samples)\n"
+        f"pull-off force: measured {pull(summary.measured_pull_off)}, model {pull(summary.model_pull_off)}\n"
+        f"wrote {args.output}"
+    )
+    if args.json is not None:
+        args.json.write_text(json.dumps(result, indent=2) + "\n", encoding="utf-8")
+    return 0
+
+
+def _write_output(path: Path, scene: SceneConfig, contact_id: str, experiment: Experiment, run: ModelRun) -> None:
+    """The model's states and wrenches on the input stamps, with the scene, as MCAP."""
+    from viscoadh_ros.io.mcap_log import McapRecorder
+    from viscoadh_ros.ros import conversions
+
+    frame = scene.node.frame_id
+    if path.exists():
+        path.unlink()
+    # Offline, nothing may be dropped: a queue that holds every message.
+    recorder = McapRecorder(path, scene=scene.to_dict(), queue_size=2 * len(run.input_outputs) + 16)
+    received = 0
+    for stamp, output in zip(experiment.input_ns.tolist(), run.input_outputs):
+        received += 1
+        state = conversions.contact_state(output, stamp_ns=stamp, frame_id=frame, model=run.model,
+                                          commands_received=received, commands_rejected=0)
+        recorder.record(f"/{contact_id}/state", state, stamp)
+        recorder.record(f"/{contact_id}/wrench", conversions.wrench(output, stamp_ns=stamp, frame_id=frame), stamp)
+    recorder.close()
+    if recorder.error is not None or recorder.dropped:
+        raise RuntimeError(f"writing {path} failed: {recorder.error!r}, {recorder.dropped} messages dropped")

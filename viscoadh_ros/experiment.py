@@ -1,0 +1,289 @@
+"""A recorded experiment (inputs + measured force) and the model run over it.
+
+Used by ``viscoadh replay`` and ``viscoadh fit``: both read the same inputs from a bag and run
+the same event loop, which is the node's own: a ``ContactSimulator.step`` at every input
+stamp, a ``ContactSimulator.advance`` (hold the last control) at every measured-force stamp in
+between. Replaying the node's own log therefore reproduces its published forces.
+
+Inputs (the control): ``viscoadh_msgs/msg/IndentationCommand`` (DEPTH or FORCE mode),
+``std_msgs/msg/Float64`` (depth, m), or the ``z`` of ``geometry_msgs/msg/PointStamped`` /
+``PoseStamped`` (depth, m, > 0 presses in). Measured force: ``geometry_msgs/msg/WrenchStamped``
+(``wrench.force.z``, N) or ``std_msgs/msg/Float64`` (N), taken as the model's sign
+(> 0 compressive, pushing the indenter out; this is what the node publishes); ``flip_force``
+negates it for load cells that read tension positive. Times: ``header.stamp`` when the message
+has one (a zero stamp means "on receipt"), else the log time.
+"""
+
+from __future__ import annotations
+
+import math
+import time as wallclock
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from viscoadh_ros.core.errors import InputError
+from viscoadh_ros.io.bag import Bag, RecordedMessage
+
+if TYPE_CHECKING:
+    from viscoadh_ros.core.config import ContactConfig, SceneConfig
+    from viscoadh_ros.core.simulator import StepOutput
+
+COMMAND = "viscoadh_msgs/msg/IndentationCommand"
+FLOAT64 = "std_msgs/msg/Float64"
+POINT = "geometry_msgs/msg/PointStamped"
+POSE = "geometry_msgs/msg/PoseStamped"
+WRENCH = "geometry_msgs/msg/WrenchStamped"
+INPUT_TYPES = (COMMAND, FLOAT64, POINT, POSE)
+FORCE_TYPES = (WRENCH, FLOAT64)
+
+DEPTH, FORCE = 0, 1  # input modes, equal to IndentationCommand.DEPTH / FORCE
+
+
+@dataclass(frozen=True)
+class Experiment:
+    """Inputs and measured force of one contact on one time base.
+
+    Times are integer ns on the recording's clock; ``time(ns)`` gives seconds since ``t0_ns``
+    (the first input), which is the simulation time.
+    """
+
+    t0_ns: int
+    input_ns: NDArray[np.int64]  # (n,) stamps of the inputs, non-decreasing
+    input_mode: NDArray[np.uint8]  # (n,) DEPTH or FORCE
+    input_value: NDArray[np.float64]  # (n,) depth, m, or force, N
+    measured_ns: NDArray[np.int64]  # (m,) stamps of the measured force (m may be 0)
+    measured_force: NDArray[np.float64]  # (m,) N, > 0 compressive
+    input_topic: str
+    force_topic: str | None
+
+    def time(self, ns: NDArray[np.int64]) -> NDArray[np.float64]:
+        """Seconds since the first input."""
+        return (np.asarray(ns, dtype=np.int64) - self.t0_ns) * 1e-9
+
+    @property
+    def duration(self) -> float:
+        """Span of the record (inputs and measured force), s."""
+        last = self.input_ns[-1] if self.measured_ns.size == 0 else max(self.input_ns[-1], self.measured_ns[-1])
+        return (int(last) - self.t0_ns) * 1e-9
+
+
+def _stamp_ns(message: RecordedMessage) -> int:
+    header = getattr(message.msg, "header", None)
+    if header is not None:
+        ns = header.stamp.sec * 1_000_000_000 + header.stamp.nanosec
+        if ns:
+            return ns
+    return message.log_time_ns
+
+
+def _input_of(message: RecordedMessage) -> tuple[int, float]:
+    msg = message.msg
+    if message.type_name == COMMAND:
+        if msg.mode not in (DEPTH, FORCE):
+            raise InputError(f"{message.topic}: IndentationCommand with unknown mode {msg.mode}")
+        return int(msg.mode), float(msg.depth if msg.mode == DEPTH else msg.force)
+    if message.type_name == FLOAT64:
+        return DEPTH, float(msg.data)
+    if message.type_name == POINT:
+        return DEPTH, float(msg.point.z)
+    return DEPTH, float(msg.pose.position.z)
+
+
+def _force_of(message: RecordedMessage) -> float:
+    if message.type_name == WRENCH:
+        return float(message.msg.wrench.force.z)
+    return float(message.msg.data)
+
+
+def _pick(bag: Bag, given: str | None, default: str | None, types: tuple[str, ...], what: str, flag: str) -> str | None:
+    """The topic named by the user, else ``default`` if recorded, else the only one of ``types``."""
+    if given:
+        topic = bag.resolve(given)
+    elif default and any(t == default or t.endswith("/" + default.strip("/")) for t in bag.topics):
+        topic = bag.resolve(default)
+    else:
+        candidates = bag.topics_of_type(*types)
+        if FLOAT64 in types and len(types) > 1:
+            # A bare Float64 could be depth or force: never guess it.
+            candidates = [t for t in candidates if bag.topics[t] != FLOAT64]
+        if len(candidates) != 1:
+            if not candidates:
+                return None
+            raise InputError(f"several {what} topics in {str(bag.path)!r} ({candidates}); choose one with {flag}")
+        topic = candidates[0]
+    if bag.topics[topic] not in types:
+        raise InputError(
+            f"{what} topic {topic!r} has type {bag.topics[topic]!r}; expected one of {list(types)}"
+        )
+    return topic
+
+
+def load_experiment(
+    bag: Bag,
+    *,
+    input_topic: str | None = None,
+    force_topic: str | None = None,
+    contact: str | None = None,
+    flip_force: bool = False,
+) -> Experiment:
+    """Read the inputs and the measured force of one contact from ``bag``.
+
+    Without explicit topics: ``<contact>/indentation`` and ``<contact>/wrench`` when ``contact``
+    is given and recorded, else the only input topic (IndentationCommand, PointStamped,
+    PoseStamped) and the only WrenchStamped topic. A Float64 topic is used only when named.
+    Raises InputError naming what is missing, ambiguous or of the wrong type.
+    """
+    inputs = _pick(bag, input_topic, f"{contact}/indentation" if contact else None,
+                   INPUT_TYPES, "input (depth)", "--depth-topic")
+    if inputs is None:
+        raise InputError(
+            f"no input topic in {str(bag.path)!r}: record IndentationCommand, PointStamped or "
+            f"PoseStamped, or name a Float64 depth with --depth-topic (topics: {bag.topics})"
+        )
+    forces = _pick(bag, force_topic, f"{contact}/wrench" if contact else None,
+                   FORCE_TYPES, "force", "--force-topic")
+    if forces == inputs:
+        raise InputError(f"the input and the force topic are both {inputs!r}")
+    rows = [(_stamp_ns(m), *_input_of(m)) for m in bag.messages([inputs])]
+    if not rows:
+        raise InputError(f"input topic {inputs!r} has no messages")
+    rows.sort(key=lambda row: row[0])
+    input_ns = np.array([r[0] for r in rows], dtype=np.int64)
+    mode = np.array([r[1] for r in rows], dtype=np.uint8)
+    value = np.array([r[2] for r in rows], dtype=np.float64)
+    if not np.all(np.isfinite(value)):
+        raise InputError(f"input topic {inputs!r} holds non-finite values")
+    measured = sorted((_stamp_ns(m), _force_of(m)) for m in bag.messages([forces])) if forces else []
+    measured_ns = np.array([m[0] for m in measured], dtype=np.int64)
+    force = np.array([m[1] for m in measured], dtype=np.float64) * (-1.0 if flip_force else 1.0)
+    # Measured samples before the first input have no model to compare with.
+    keep = measured_ns >= input_ns[0]
+    if forces and not np.any(keep):
+        raise InputError(
+            f"empty time range: force topic {forces!r} ends before input topic {inputs!r} starts"
+        )
+    finite = np.isfinite(force[keep])
+    if not np.all(finite):
+        raise InputError(f"force topic {forces!r} holds non-finite values")
+    return Experiment(
+        t0_ns=int(input_ns[0]),
+        input_ns=input_ns,
+        input_mode=mode,
+        input_value=value,
+        measured_ns=measured_ns[keep],
+        measured_force=force[keep],
+        input_topic=inputs,
+        force_topic=forces,
+    )
+
+
+def choose_contact(scene: SceneConfig, contact: str | None, input_topic: str | None = None) -> ContactConfig:
+    """The contact of ``scene`` to run: the one named, the only one, or the one whose id is the
+    namespace of ``input_topic`` (``/finger/indentation`` -> ``finger``)."""
+    ids = [c.id for c in scene.contacts]
+    if contact is None and len(ids) == 1:
+        contact = ids[0]
+    if contact is None and input_topic:
+        parts = input_topic.strip("/").split("/")
+        contact = next((p for p in reversed(parts[:-1]) if p in ids), None)
+    if contact is None:
+        raise InputError(f"the scene has contacts {ids}; choose one with --contact")
+    if contact not in ids:
+        raise InputError(f"contact {contact!r} is not in the scene (contacts: {ids})")
+    return scene.contact(contact)
+
+
+@dataclass(frozen=True)
+class ModelRun:
+    """The model over an experiment: outputs at the inputs, force at the measured stamps."""
+
+    input_outputs: list[StepOutput]  # (n,) one per input
+    model_force: NDArray[np.float64]  # (m,) N, at Experiment.measured_ns
+    wall_time: float  # s spent simulating
+    model: str  # ContactSimulator.model: "closed_form" or "time_stepped"
+
+
+def run_model(
+    contact: ContactConfig,
+    experiment: Experiment,
+    *,
+    progress: Callable[[int], Any] | None = None,
+) -> ModelRun:
+    """Run ``contact``'s model over ``experiment`` from a fresh state (the node's event loop).
+
+    ``progress(k)`` is called with the number of events done since the last call.
+    """
+    from viscoadh_ros.core.simulator import ContactSimulator  # numba: loaded only to simulate
+
+    n, m = experiment.input_ns.size, experiment.measured_ns.size
+    stamps = np.concatenate([experiment.input_ns, experiment.measured_ns])
+    kinds = np.concatenate([np.zeros(n, np.int8), np.ones(m, np.int8)])
+    index = np.concatenate([np.arange(n), np.arange(m)])
+    # By stamp; at equal stamps the input first, as the node publishes after stepping.
+    order = np.lexsort((kinds, stamps))
+    times = experiment.time(stamps)
+    sim = ContactSimulator(contact)
+    outputs: list[StepOutput] = [None] * n  # type: ignore[list-item]
+    model_force = np.empty(m)
+    started = wallclock.perf_counter()
+    batch = max(1, order.size // 200)
+    for k, event in enumerate(order):
+        t = max(float(times[event]), sim.time)
+        i = int(index[event])
+        if kinds[event] == 0:
+            key = "depth" if experiment.input_mode[i] == DEPTH else "force"
+            outputs[i] = sim.step(t, **{key: float(experiment.input_value[i])})
+        else:
+            model_force[i] = (sim.advance(t) if t > sim.time else sim.output).force
+        if progress is not None and (k + 1) % batch == 0:
+            progress(batch)
+    if progress is not None and order.size % batch:
+        progress(order.size % batch)
+    return ModelRun(outputs, model_force, wallclock.perf_counter() - started, sim.model)
+
+
+@dataclass(frozen=True)
+class Comparison:
+    """Model vs measured force (N) and replay speed."""
+
+    samples: int
+    rmse: float
+    max_error: float
+    measured_pull_off: float | None  # most tensile measured force, N (None: never < 0)
+    model_pull_off: float | None
+    speed: float  # record duration / wall time (multiples of real time)
+
+    def as_dict(self) -> dict[str, Any]:
+        """JSON-ready summary with units in the keys."""
+        return {
+            "samples": self.samples,
+            "rmse_N": self.rmse,
+            "max_error_N": self.max_error,
+            "measured_pull_off_force_N": self.measured_pull_off,
+            "model_pull_off_force_N": self.model_pull_off,
+            "replay_speed_x_real_time": self.speed,
+        }
+
+
+def _pull_off(force: NDArray[np.float64]) -> float | None:
+    low = float(np.min(force)) if force.size else 0.0
+    return low if low < 0.0 else None
+
+
+def compare(experiment: Experiment, run: ModelRun) -> Comparison:
+    """Errors of ``run`` against ``experiment``'s measured force."""
+    if experiment.measured_force.size == 0:
+        raise InputError("no measured force to compare with")
+    error = run.model_force - experiment.measured_force
+    return Comparison(
+        samples=int(error.size),
+        rmse=float(np.sqrt(np.mean(error**2))),
+        max_error=float(np.max(np.abs(error))),
+        measured_pull_off=_pull_off(experiment.measured_force),
+        model_pull_off=_pull_off(run.model_force),
+        speed=experiment.duration / run.wall_time if run.wall_time > 0 else math.inf,
+    )

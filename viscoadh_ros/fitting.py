@@ -1,0 +1,212 @@
+"""Identify material parameters from a recorded experiment by least squares (scipy).
+
+Parameters are named as in physics.md: ``G0`` (glass shear modulus, Pa), ``G1..GK`` (Kelvin
+shear moduli, Pa), ``eta1..etaK`` (Kelvin viscosities, Pa s) and ``work_of_adhesion`` (J/m^2).
+The fit works on their logarithms (all are positive and span decades) with residuals
+``(model - measured) / max|measured|`` at the measured-force stamps, in two stages
+(physics.md section 7): the compressive samples first with the work of adhesion held, then
+every sample with every free parameter. Uncertainties (one standard deviation) come from the
+Jacobian at the optimum: ``cov = s^2 (J^T J)^-1`` with the residual variance ``s^2``.
+
+A parameter the data cannot fix (no pull-off for the work of adhesion, no rate or hold
+variation for a viscosity, two parameters that only act together) makes the fit fail with a
+:class:`FitError` naming it, never a value with a meaningless error bar.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import re
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.optimize import least_squares
+
+from viscoadh_ros.core.config import ContactConfig
+from viscoadh_ros.core.errors import InputError
+from viscoadh_ros.experiment import Experiment, run_model
+
+_NAME = re.compile(r"^(G0|G[1-9]\d*|eta[1-9]\d*|work_of_adhesion)$")
+UNITS = {"G": "Pa", "eta": "Pa s", "work_of_adhesion": "J/m^2"}
+#: Largest relative standard deviation accepted as "identified".
+MAX_RELATIVE_UNCERTAINTY = 0.5
+#: Condition number of the column-scaled Jacobian beyond which parameters only act together.
+MAX_CONDITION = 1e6
+
+
+class FitError(InputError):
+    """The data cannot identify a free parameter, or the fit did not converge."""
+
+
+def unit_of(name: str) -> str:
+    """SI unit of a parameter name."""
+    if name == "work_of_adhesion":
+        return UNITS[name]
+    return UNITS["eta"] if name.startswith("eta") else UNITS["G"]
+
+
+def parameter_names(kelvin: int) -> list[str]:
+    """All parameter names of a chain with ``kelvin`` Kelvin elements."""
+    return ["G0", *(f"G{k}" for k in range(1, kelvin + 1)), *(f"eta{k}" for k in range(1, kelvin + 1)),
+            "work_of_adhesion"]
+
+
+def parse_free(text: str, kelvin: int) -> list[str]:
+    """``"G0,G1,eta1"`` -> names, checked against the chain; InputError on an unknown one."""
+    names = [n.strip() for n in text.split(",") if n.strip()]
+    allowed = parameter_names(kelvin)
+    for name in names:
+        if not _NAME.match(name) or name not in allowed:
+            raise InputError(f"--free: unknown parameter {name!r} for {kelvin} Kelvin element(s); known: {allowed}")
+    if len(set(names)) != len(names) or not names:
+        raise InputError(f"--free must name each parameter once (got {text!r})")
+    return names
+
+
+def parameters_of(contact: ContactConfig) -> dict[str, float]:
+    """Current parameter values of a contact."""
+    material = contact.material
+    values = {"G0": float(material.glass_shear_modulus)}
+    for k, (g, eta) in enumerate(zip(material.kelvin_shear_moduli, material.kelvin_viscosities), start=1):
+        values[f"G{k}"] = float(g)
+        values[f"eta{k}"] = float(eta)
+    values["work_of_adhesion"] = float(contact.adhesion.work_of_adhesion)
+    return values
+
+
+def with_parameters(contact: ContactConfig, values: dict[str, float], kelvin: int) -> ContactConfig:
+    """``contact`` with the material and adhesion set from ``values`` (all names of the chain)."""
+    material = dataclasses.replace(
+        contact.material,
+        glass_shear_modulus=values["G0"],
+        kelvin_shear_moduli=tuple(values[f"G{k}"] for k in range(1, kelvin + 1)),
+        kelvin_viscosities=tuple(values[f"eta{k}"] for k in range(1, kelvin + 1)),
+    )
+    adhesion = dataclasses.replace(contact.adhesion, work_of_adhesion=values["work_of_adhesion"])
+    return dataclasses.replace(contact, material=material, adhesion=adhesion)
+
+
+def initial_values(contact: ContactConfig, kelvin: int) -> dict[str, float]:
+    """Start values from ``contact``; a chain of another length is spread over decades of
+    retardation time around the base one, with the same relaxed compliance."""
+    base = parameters_of(contact)
+    base_k = len(contact.material.kelvin_shear_moduli)
+    if base_k == kelvin:
+        return base
+    if base_k == 0:
+        raise InputError("the base scene has no Kelvin element to start a viscoelastic fit from")
+    g1, tau1 = base["G1"], base["eta1"] / base["G1"]
+    values = {"G0": base["G0"], "work_of_adhesion": base["work_of_adhesion"]}
+    for k in range(1, kelvin + 1):
+        tau = tau1 * 10.0 ** (k - (kelvin + 1) / 2)
+        values[f"G{k}"] = g1 * kelvin
+        values[f"eta{k}"] = g1 * kelvin * tau
+    return values
+
+
+@dataclass(frozen=True)
+class FitResult:
+    """Fitted values (SI) with one-sigma uncertainties, and the fit error."""
+
+    values: dict[str, float]  # every parameter of the chain (free and held)
+    uncertainty: dict[str, float]  # free parameters only
+    free: tuple[str, ...]
+    rmse: float  # N
+    max_error: float  # N
+    samples: int
+    contact: ContactConfig  # the base contact with the fitted values
+
+
+def _identify_checks(experiment: Experiment, free: Sequence[str]) -> None:
+    if experiment.measured_force.size < len(free) + 2:
+        raise FitError(f"{experiment.measured_force.size} force samples cannot fit {len(free)} parameters")
+    if "work_of_adhesion" in free and not np.any(experiment.measured_force < 0.0):
+        raise FitError(
+            "work_of_adhesion cannot be identified: the measured force is never tensile (no "
+            "pull-off in the record); hold it (leave it out of --free) or record a retraction"
+        )
+    if np.any(experiment.input_mode != 0):
+        raise FitError("fit needs depth-controlled inputs; the record holds FORCE-mode commands")
+
+
+def fit(
+    contact: ContactConfig,
+    experiment: Experiment,
+    free: Sequence[str],
+    *,
+    kelvin: int = 1,
+) -> FitResult:
+    """Fit the ``free`` parameters of ``contact`` (``kelvin`` Kelvin elements) to ``experiment``.
+
+    Raises FitError when a parameter is not identified by the data.
+    """
+    _identify_checks(experiment, free)
+    values = initial_values(contact, kelvin)
+    for name in free:
+        if not values[name] > 0.0 or not math.isfinite(values[name]):
+            raise InputError(f"start value of {name} must be finite and > 0 (got {values[name]})")
+    measured = experiment.measured_force
+    scale = float(np.max(np.abs(measured)))
+
+    def model(theta: NDArray[np.float64], names: Sequence[str]) -> NDArray[np.float64]:
+        trial = dict(values)
+        trial.update({n: float(math.exp(t)) for n, t in zip(names, theta)})
+        try:
+            return run_model(with_parameters(contact, trial, kelvin), experiment).model_force
+        except ValueError:
+            # The optimiser stepped outside what the model accepts: a large residual steers it back.
+            return np.full(measured.shape, 1e3 * scale)
+
+    stage1 = [n for n in free if n != "work_of_adhesion"]
+    compressive = measured > 0.0
+    if stage1 and "work_of_adhesion" in free and np.count_nonzero(compressive) > len(stage1) + 1:
+        x0 = np.log([values[n] for n in stage1])
+        first = least_squares(lambda th: (model(th, stage1)[compressive] - measured[compressive]) / scale,
+                              x0, diff_step=1e-4, x_scale=1.0)
+        values.update({n: float(math.exp(t)) for n, t in zip(stage1, first.x)})
+    x0 = np.log([values[n] for n in free])
+    result = least_squares(lambda th: (model(th, free) - measured) / scale, x0, diff_step=1e-4, x_scale=1.0)
+    if not result.success:
+        raise FitError(f"the fit did not converge: {result.message}")
+    values.update({n: float(math.exp(t)) for n, t in zip(free, result.x)})
+    sigma = _uncertainty(result.jac, result.fun, free)
+    residual = result.fun * scale
+    return FitResult(
+        values=values,
+        uncertainty={n: values[n] * s for n, s in zip(free, sigma)},
+        free=tuple(free),
+        rmse=float(np.sqrt(np.mean(residual**2))),
+        max_error=float(np.max(np.abs(residual))),
+        samples=int(measured.size),
+        contact=with_parameters(contact, values, kelvin),
+    )
+
+
+def _uncertainty(jac: NDArray[np.float64], fun: NDArray[np.float64], free: Sequence[str]) -> NDArray[np.float64]:
+    """Standard deviations of the log-parameters; FitError for unidentified ones."""
+    norms = np.linalg.norm(jac, axis=0)
+    dead = [n for n, c in zip(free, norms) if not c > 1e-12 * max(float(np.max(norms)), 1e-300)]
+    if dead:
+        raise FitError(f"{', '.join(dead)} cannot be identified: the force does not depend on it in this record")
+    scaled = jac / norms
+    _, singular, vt = np.linalg.svd(scaled, full_matrices=False)
+    if singular[-1] <= 0 or singular[0] / singular[-1] > MAX_CONDITION:
+        involved = [n for n, v in zip(free, vt[-1]) if abs(v) > 0.3]
+        raise FitError(
+            f"{', '.join(involved)} cannot be identified separately from this record (they only act "
+            "together; a viscosity needs a change of rate or a hold); fix one of them"
+        )
+    dof = max(fun.size - len(free), 1)
+    s2 = float(fun @ fun) / dof
+    cov = s2 * np.linalg.inv(jac.T @ jac)
+    sigma = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+    vague = [f"{n} (+-{100 * s:.0f}%)" for n, s in zip(free, sigma) if s > MAX_RELATIVE_UNCERTAINTY]
+    if vague:
+        raise FitError(
+            f"{', '.join(vague)} not identified by this record (a viscosity needs a change of rate "
+            "or a hold; the work of adhesion a pull-off); fix it or record more"
+        )
+    return sigma
