@@ -1,0 +1,1 @@
+"""The `viscoadh` command line tools."""
