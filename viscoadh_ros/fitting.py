@@ -20,14 +20,17 @@ import math
 import re
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import least_squares
 
-from viscoadh_ros.core.config import ContactConfig
 from viscoadh_ros.core.errors import InputError
 from viscoadh_ros.experiment import Experiment, run_model
+
+if TYPE_CHECKING:
+    from viscoadh_ros.core.config import ContactConfig
 
 _NAME = re.compile(r"^(G0|G[1-9]\d*|eta[1-9]\d*|work_of_adhesion)$")
 UNITS = {"G": "Pa", "eta": "Pa s", "work_of_adhesion": "J/m^2"}

@@ -11,11 +11,14 @@ import argparse
 import json
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from viscoadh_ros.core.config import SceneConfig
 from viscoadh_ros.core.errors import InputError
 from viscoadh_ros.experiment import Experiment, ModelRun, choose_contact, compare, load_experiment, run_model
 from viscoadh_ros.io.bag import Bag
+
+if TYPE_CHECKING:
+    from viscoadh_ros.core.config import SceneConfig
 
 
 def add_input_arguments(parser: argparse.ArgumentParser) -> None:
@@ -38,13 +41,6 @@ def open_experiment(args: argparse.Namespace) -> tuple[Bag, SceneConfig, Experim
     bag = Bag(args.bag, recover=args.recover)
     for path in bag.truncated:
         print(f"viscoadh: warning: {path} is unfinished; using its complete chunks", file=sys.stderr)
-    if args.scene is not None:
-        scene = SceneConfig.from_yaml(args.scene)
-    else:
-        stored = bag.scene()
-        if stored is None:
-            raise InputError(f"{str(args.bag)!r} stores no scene (not a log of our node); pass --scene")
-        scene = SceneConfig.from_dict(stored)
     experiment = load_experiment(
         bag,
         input_topic=args.depth_topic,
@@ -57,6 +53,15 @@ def open_experiment(args: argparse.Namespace) -> tuple[Bag, SceneConfig, Experim
             f"no measured force in {str(args.bag)!r}: record a WrenchStamped or name a Float64 "
             f"force with --force-topic (topics: {bag.topics})"
         )
+    from viscoadh_ros.core.config import SceneConfig
+
+    if args.scene is not None:
+        scene = SceneConfig.from_yaml(args.scene)
+    else:
+        stored = bag.scene()
+        if stored is None:
+            raise InputError(f"{str(args.bag)!r} stores no scene (not a log of our node); pass --scene")
+        scene = SceneConfig.from_dict(stored)
     return bag, scene, experiment
 
 

@@ -1,0 +1,64 @@
+"""replay/fit on unusable recordings: one clear error line, exit code 2, no traceback."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from geometry_msgs.msg import PointStamped, WrenchStamped
+from std_msgs.msg import Float64, String
+
+from viscoadh_ros.cli.main import main
+from viscoadh_ros.io.mcap_log import McapRecorder
+
+
+def _bag(path: Path, *, force: bool = True, late_force: bool = False, extra: bool = False) -> Path:
+    with McapRecorder(path) as rec:
+        for i in range(5):
+            point = PointStamped()
+            point.header.stamp.sec = 10 + i
+            point.point.z = 1e-6 * i
+            rec.record("/probe/depth", point, 1)
+            if force:
+                wrench = WrenchStamped()
+                wrench.header.stamp.sec = (100 if late_force else 10) + i
+                wrench.header.stamp.sec -= 200 if late_force else 0
+                wrench.wrench.force.z = 0.1 * i
+                rec.record("/loadcell", wrench, 1)
+            if extra:
+                rec.record("/note", String(data="x"), 1)
+                rec.record("/other_depth", point, 1)
+    return path
+
+
+CASES = {
+    "missing topic": (lambda p: _bag(p), ["--depth-topic", "nope"], "topic 'nope' is not in"),
+    "unknown type": (lambda p: _bag(p, extra=True), ["--depth-topic", "note"], "has type 'std_msgs/msg/String'"),
+    "ambiguous": (lambda p: _bag(p, extra=True), [], "several input (depth) topics"),
+    "no force": (lambda p: _bag(p, force=False), [], "no measured force"),
+    "empty time range": (lambda p: _bag(p, late_force=True), [], "empty time range"),
+    "truncated": (lambda p: _truncate(_bag(p)), [], "truncated"),
+    "not mcap": (lambda p: (p.write_bytes(b"hello, this is not a bag at all"), p)[1], [], "not an MCAP file"),
+    "missing bag": (lambda p: p, [], "does not exist"),
+}
+
+
+def _truncate(path: Path) -> Path:
+    data = path.read_bytes()
+    path.write_bytes(data[: len(data) // 2])
+    return path
+
+
+@pytest.mark.parametrize("verb", ["replay", "fit"])
+@pytest.mark.parametrize("case", sorted(CASES))
+def test_bad_recording_gives_one_line(case: str, verb: str, tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
+    make, extra_args, expected = CASES[case]
+    bag = make(tmp_path / "in.mcap")
+    out = tmp_path / ("out.mcap" if verb == "replay" else "out.yaml")
+    code = main([verb, str(bag), "-o", str(out), *extra_args])
+    err = capsys.readouterr().err
+    assert code == 2, f"{case}: exit code {code}, stderr {err!r}"
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith(f"viscoadh {verb}: error:"), f"{case}: {err!r}"
+    assert expected in lines[0], f"{case}: {lines[0]!r}"
+    assert not out.exists(), f"{case}: nothing may be written"
