@@ -51,10 +51,10 @@ class JkrReference:
 
     def branch(self, work: float, radius: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """JKR (depth, force) along contact radii ``radius`` for work of adhesion ``work``."""
-        r, e = self.radius, self.relaxed_modulus
-        depth = radius**2 / r - np.sqrt(2.0 * math.pi * radius * work / e)
-        force = 4.0 * e * radius**3 / (3.0 * r) - np.sqrt(8.0 * math.pi * work * e * radius**3)
-        return depth, force
+        from viscoadh_ros.core import reference
+
+        args = (self.radius, self.relaxed_modulus, work)
+        return reference.jkr_depth(radius, *args), reference.jkr_force(radius, *args)
 
     @property
     def scales(self) -> tuple[float, float, float]:
