@@ -217,7 +217,9 @@ def run_model(
 
     ``progress(k)`` is called with the number of events done since the last call.
     """
-    from viscoadh_ros.core.simulator import ContactSimulator  # numba: loaded only to simulate
+    from viscoadh_ros.core.simulator import (
+        ContactSimulator,  # numba: loaded only to simulate
+    )
 
     n, m = experiment.input_ns.size, experiment.measured_ns.size
     stamps = np.concatenate([experiment.input_ns, experiment.measured_ns])

@@ -39,7 +39,7 @@ class JkrReference:
     work_detachment: float
 
     @classmethod
-    def from_contact(cls, contact) -> JkrReference | None:  # noqa: ANN001 - core ContactConfig
+    def from_contact(cls, contact) -> JkrReference | None:
         """The reference of a sphere contact with adhesion; None for other indenters."""
         if contact.indenter.shape != "sphere" or not contact.adhesion.work_of_adhesion > 0:
             return None

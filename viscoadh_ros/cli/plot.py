@@ -42,7 +42,7 @@ def _csv_curves(path: Path) -> list[Curve]:
     return [Curve(*(np.atleast_1d(table[c]) for c in COLUMNS), label=path.stem)]
 
 
-def _mcap_curves(args: argparse.Namespace):  # noqa: ANN202 - (curves, stored scene dict or None)
+def _mcap_curves(args: argparse.Namespace):
     from viscoadh_ros.io.bag import Bag
 
     bag = Bag(args.input, recover=args.recover)

@@ -14,7 +14,14 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from viscoadh_ros.core.errors import InputError
-from viscoadh_ros.experiment import Experiment, ModelRun, choose_contact, compare, load_experiment, run_model
+from viscoadh_ros.experiment import (
+    Experiment,
+    ModelRun,
+    choose_contact,
+    compare,
+    load_experiment,
+    run_model,
+)
 from viscoadh_ros.io.bag import Bag
 
 if TYPE_CHECKING:
@@ -77,7 +84,9 @@ def main(args: argparse.Namespace) -> int:
     _, scene, experiment = open_experiment(args)
     contact = choose_contact(scene, args.contact, experiment.input_topic)
 
-    from tqdm import tqdm  # progress only on a terminal (tqdm disables itself otherwise)
+    from tqdm import (
+        tqdm,  # progress only on a terminal (tqdm disables itself otherwise)
+    )
 
     events = experiment.input_ns.size + experiment.measured_ns.size
     with tqdm(total=events, unit="step", file=sys.stderr, disable=None, leave=False) as bar:
@@ -87,7 +96,7 @@ def main(args: argparse.Namespace) -> int:
 
     result = {"bag": str(args.bag), "contact": contact.id, "input_topic": experiment.input_topic,
               "force_topic": experiment.force_topic, "output": str(args.output), **summary.as_dict()}
-    pull = lambda f: "none (never tensile)" if f is None else f"{f:.6g} N"  # noqa: E731
+    pull = lambda f: "none (never tensile)" if f is None else f"{f:.6g} N"
     print(
         f"replayed {experiment.input_ns.size} inputs of {contact.id} over {experiment.duration:.3f} s "
         f"at {summary.speed:.3g}x real time\n"

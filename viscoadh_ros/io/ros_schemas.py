@@ -74,7 +74,7 @@ def _prefixes(package: str) -> list[Path]:
     return prefixes
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def msg_file(package: str, name: str) -> Path:
     """Path of the installed ``<package>/msg/<name>.msg``; InputError if none is found."""
     for prefix in _prefixes(package):
@@ -109,7 +109,7 @@ def _dependencies(package: str, text: str) -> list[tuple[str, str]]:
     return deps
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def schema_text(type_name: str) -> str:
     """Full ``ros2msg`` schema text of ``pkg/msg/Type`` with every dependency appended once."""
     package, name = split_type_name(type_name)
