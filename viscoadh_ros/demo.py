@@ -397,11 +397,13 @@ def node_in_process(
     ``parameters`` are extra node parameters by their flat names (``use_sim_time=True``,
     ``**{"log.enabled": True}``). Yields (context, executor): create client nodes with
     ``Node(name, context=context)`` and ``executor.add_node(node)``. The ROS traffic stays in
-    this process (``ROS_AUTOMATIC_DISCOVERY_RANGE=OFF`` for the context's lifetime). On exit
+    this process (discovery range OFF while the context is created). On exit
     the node is destroyed (which finishes its MCAP log) and the context shut down.
     """
-    previous = os.environ.get(_DISCOVERY_RANGE)
-    os.environ[_DISCOVERY_RANGE] = "OFF"
+    # rcl reads these at init; ROS_LOCALHOST_ONLY (deprecated) would override the range.
+    private = {_DISCOVERY_RANGE: "OFF", "ROS_LOCALHOST_ONLY": None}
+    previous = {name: os.environ.get(name) for name in private}
+    _set_environment(private)
     context = rclpy.context.Context()
     try:
         rclpy.init(context=context, args=[])
@@ -422,10 +424,16 @@ def node_in_process(
             node.destroy_node()
     finally:
         rclpy.try_shutdown(context=context)
-        if previous is None:
-            del os.environ[_DISCOVERY_RANGE]
+        _set_environment(previous)
+
+
+def _set_environment(values: dict[str, str | None]) -> None:
+    """Set environment variables; None removes one."""
+    for name, value in values.items():
+        if value is None:
+            os.environ.pop(name, None)
         else:
-            os.environ[_DISCOVERY_RANGE] = previous
+            os.environ[name] = value
 
 
 def run_demo(
