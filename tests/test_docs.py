@@ -22,7 +22,8 @@ def test_version_is_semantic_and_agrees_everywhere():
     assert package_xml == __version__, f"package.xml says {package_xml}, __init__ {__version__}"
     msgs_xml = ET.parse(REPO / "msg_defs" / "package.xml").getroot().findtext("version")
     assert msgs_xml == __version__, f"msg_defs/package.xml says {msgs_xml}, __init__ {__version__}"
-    releases = re.findall(r"^## \[(\d[^\]]*)\] - \d{4}-\d{2}-\d{2}$", (REPO / "CHANGELOG.md").read_text(), re.M)
+    changelog = (REPO / "CHANGELOG.md").read_text()
+    releases = re.findall(r"^## \[(\d[^\]]*)\] - \d{4}-\d{2}-\d{2}$", changelog, re.M)
     assert releases, "CHANGELOG.md has no release heading '## [X.Y.Z] - YYYY-MM-DD'"
     assert releases[0] == __version__, f"newest CHANGELOG release {releases[0]}, __init__ {__version__}"
 

@@ -251,7 +251,7 @@ def drive_cycle(driver: _Driver, plan: CyclePlan) -> DemoRun:
     states = []
     prediction = None
     started = wallclock.perf_counter()
-    for index, (time, depth) in enumerate(zip(times, depths)):
+    for index, (time, depth) in enumerate(zip(times, depths, strict=True)):
         state = driver.command(_CLOCK_START_S + time, depth)
         states.append(state)
         if index == last_hold:
