@@ -1,0 +1,697 @@
+"""The stateful contact simulator: one axisymmetric adhesive contact, stepped in time.
+
+`ContactSimulator(contact)` owns the state of one contact and advances it with
+``step(time, depth=...)`` (displacement control) or ``step(time, force=...)`` (force
+control), like scipy's ``OdeSolver.step()``. Between two commands the depth is linear in
+time (a sampled history is a piecewise-linear one). ``snapshot()``/``restore()`` copy the
+state cheaply, so "what if" questions never disturb the live contact.
+
+Two model paths ("model only what the scene requires", `model` says which):
+
+- ``closed_form``: elastic scenes (no Kelvin element) with a sphere, cone, flat punch or
+  power-law indenter. The edge follows the JKR-type law ``d = g(a) - dl_c(a)`` on its
+  outer (displacement-stable) branch, ``dl_c(a) = sqrt(2 pi a w / E0*)``; the contact
+  snaps in when the indenter touches (d >= 0) and lets go at the fold of that law (flat
+  punch: Kendall, ``d = -dl_c(a0)``). Nothing is discretised.
+- ``time_stepped``: the 1D MDR row of creep elements with the energy criterion on the
+  glass springs, a continuous contact radius and exact exponential integration
+  (see `_kernels`). Needed whenever memory matters (K >= 1) or for a tabulated profile.
+
+Outputs (`StepOutput`), beyond depth, force and radius:
+
+- ``effective_work_of_adhesion`` (J/m^2): ``E_r* u(a)^2 / (2 pi a)`` with
+  ``u(a) = d - g(a)`` the total elongation of the edge element and ``E_r*`` the relaxed
+  modulus, 0 when the edge is compressed or out of contact. It is the work of adhesion a
+  relaxed elastic JKR contact would need to hold the edge where it is: ``w G1/(G0+G1)``
+  for quasistatic indentation (fresh edge elements), ``w (G0+G1)/G1`` for quasistatic
+  detachment (relaxed edge elements), ``w`` for an elastic contact.
+- ``energy_input`` (J): ``integral F dd`` since the last reset (trapezoidal on the
+  substeps of the time-stepped path, exact on the closed-form path).
+- ``energy_dissipated`` (J): input minus the elastic energy stored in all springs (glass
+  and Kelvin, interior and the residual memory outside) minus the surface energy
+  ``-w pi a^2``; viscous work plus adhesion hysteresis. Zero along an elastic
+  equilibrium branch; it grows at snap-in, pull-off and through the dampers.
+- ``scale_separation_ok``: the energy criterion assumes the edge moves fast compared
+  with relaxation over the interaction range h (paper, section 5). With
+  ``v_c1 = pi G0 h^2 / (tau w)`` (tau = the shortest relaxation time, the strict side)
+  and ``v_c2 = v_c1 (E_r*/E0*)^2``: an advancing edge needs ``|edge_speed| >= v_c1``, a
+  receding one ``|edge_speed| >= v_c2``. A pinned edge, no contact, an elastic material
+  or ``w = 0`` are always ok.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields
+from enum import IntEnum
+from typing import Any
+
+import numpy as np
+from scipy.optimize import brentq
+
+from . import _kernels
+from .criterion import critical_glass_elongation
+from .errors import ConfigError, InputError, require_finite
+from .presets import ResolvedNumerics, resolve_numerics
+from .profiles import Profile, make_profile
+from .rheology import CreepElement
+
+
+class Phase(IntEnum):
+    """Phase of the contact edge (values equal the ContactState message constants)."""
+
+    NO_CONTACT = 0
+    INDENTING = 1
+    STICKING = 2
+    DETACHING = 3
+
+
+@dataclass(frozen=True)
+class StepOutput:
+    """The state after one step (SI units; see the module docstring for the definitions)."""
+
+    time: float
+    depth: float
+    force: float
+    contact_radius: float
+    phase: Phase
+    edge_speed: float
+    effective_work_of_adhesion: float
+    energy_input: float
+    energy_dissipated: float
+    scale_separation_ok: bool
+    unstable: bool
+
+
+STEP_OUTPUT_FIELDS = tuple(f.name for f in fields(StepOutput))
+
+_CLOSED_FORM_EXPONENT = {"sphere": 2.0, "cone": 1.0}
+
+
+class _Physics:
+    """Derived constants of a scene shared by both model paths."""
+
+    def __init__(self, contact: Any) -> None:
+        self.profile: Profile = make_profile(contact.indenter)
+        self.creep = CreepElement.from_config(contact.material)
+        self.work_of_adhesion = require_finite("adhesion.work_of_adhesion", contact.adhesion.work_of_adhesion)
+        if self.work_of_adhesion < 0.0:
+            raise InputError(f"adhesion.work_of_adhesion must be >= 0 (got {self.work_of_adhesion!r})")
+        self.interaction_range = require_finite("adhesion.interaction_range", contact.adhesion.interaction_range)
+        if self.interaction_range <= 0.0:
+            raise InputError(f"adhesion.interaction_range must be > 0 (got {self.interaction_range!r})")
+        self.e0 = self.creep.glass_modulus_star
+        self.e_relaxed = self.creep.relaxed_modulus_star
+        # dl_c(x) = c_crit * sqrt(x)
+        self.c_crit = float(critical_glass_elongation(1.0, self.work_of_adhesion, self.e0))
+        if self.creep.kelvin_count and self.work_of_adhesion > 0.0:
+            tau = float(np.min(self.creep.relaxation_times))
+            self.v_attach = (
+                math.pi * self.creep.glass_shear_modulus * self.interaction_range**2 / (tau * self.work_of_adhesion)
+            )
+            self.v_detach = self.v_attach * (self.e_relaxed / self.e0) ** 2
+        else:
+            self.v_attach = self.v_detach = 0.0
+
+    def edge_elongation(self, depth: float, radius: float) -> float:
+        """Total elongation u(a) = d - g(a) of the edge element, m."""
+        return depth - float(self.profile.g(radius))
+
+    def effective_work(self, depth: float, radius: float) -> float:
+        if radius <= 0.0:
+            return 0.0
+        u = self.edge_elongation(depth, radius)
+        return self.e_relaxed * u * u / (2.0 * math.pi * radius) if u < 0.0 else 0.0
+
+    def scale_separation_ok(self, edge_speed: float) -> bool:
+        if edge_speed > 0.0:
+            return edge_speed >= self.v_attach
+        if edge_speed < 0.0:
+            return -edge_speed >= self.v_detach
+        return True
+
+    def adhesion_length(self) -> float:
+        """Contact radius of the relaxed JKR contact at zero depth with the detachment-side
+        effective work (``w (E0*/E_r*)``), m: the natural domain scale of an adhesive scene."""
+        w_eff = self.work_of_adhesion * self.e0 / self.e_relaxed
+        c = math.sqrt(2.0 * math.pi * w_eff / self.e_relaxed)
+        x = max(self.profile.characteristic_radius, 1e-30) if math.isfinite(self.profile.characteristic_radius) else 1.0
+        # g(x) = c sqrt(x): shrink/grow x geometrically to bracket, then bisect.
+        lo, hi = x, x
+        while float(self.profile.g(lo)) > c * math.sqrt(lo) and lo > 1e-300:
+            lo *= 0.5
+        while float(self.profile.g(hi)) < c * math.sqrt(hi) and hi < 1e300:
+            hi *= 2.0
+        for _ in range(200):
+            mid = math.sqrt(lo * hi)
+            if float(self.profile.g(mid)) < c * math.sqrt(mid):
+                lo = mid
+            else:
+                hi = mid
+            if hi <= lo * (1.0 + 1e-12):
+                break
+        return hi
+
+
+class _ClosedForm:
+    """Elastic contact in closed form: state is only the contact radius (hysteresis)."""
+
+    name = "closed_form"
+
+    def __init__(self, physics: _Physics) -> None:
+        self.physics = physics
+        profile = physics.profile
+        self.punch_radius = getattr(profile, "punch_radius", None)
+        if profile.kind == "power_law":
+            self.exponent = float(profile.exponent)
+        else:
+            self.exponent = _CLOSED_FORM_EXPONENT.get(profile.kind, 0.0)
+        self.radius = 0.0
+
+    @staticmethod
+    def eligible(physics: _Physics) -> str:
+        """Empty if the scene has a closed form, else the reason why not."""
+        if physics.creep.kelvin_count:
+            return "the material has Kelvin elements (memory)"
+        if physics.profile.kind not in ("sphere", "cone", "flat_punch", "power_law"):
+            return f"indenter.shape {physics.profile.kind!r} has no closed form"
+        if physics.profile.kind == "power_law" and physics.work_of_adhesion > 0.0 and physics.profile.exponent <= 0.5:
+            return "a power law with exponent <= 0.5 has no adhesive equilibrium"
+        return ""
+
+    # -- the edge law -------------------------------------------------------------------
+    def _gap(self, depth: float, radius: float) -> float:
+        return depth - float(self.physics.profile.g(radius)) + self.physics.c_crit * math.sqrt(radius)
+
+    def _fold(self) -> tuple[float, float]:
+        """(radius, depth) of the fold of the edge law: the last displacement-stable point."""
+        c = self.physics.c_crit
+        if self.punch_radius is not None:
+            return self.punch_radius, -c * math.sqrt(self.punch_radius)
+        if c == 0.0:
+            return 0.0, 0.0
+        n = self.exponent
+        k = float(self.physics.profile.g(1.0))
+        radius = (c / (2.0 * n * k)) ** (1.0 / (n - 0.5))
+        return radius, k * radius**n - c * math.sqrt(radius)
+
+    def _outer_root(self, depth: float) -> float:
+        """Contact radius on the outer branch at `depth`, 0 if the branch does not reach it."""
+        if self.punch_radius is not None:
+            return self.punch_radius
+        fold_radius, fold_depth = self._fold()
+        if depth < fold_depth:
+            return 0.0
+        if self.physics.c_crit == 0.0:
+            return float(self.physics.profile.radius_at_height(depth))
+        hi = max(2.0 * fold_radius, float(self.physics.profile.radius_at_height(max(depth, 0.0))))
+        while self._gap(depth, hi) >= 0.0:
+            hi *= 2.0
+        if self._gap(depth, fold_radius) <= 0.0:
+            return fold_radius
+        return brentq(lambda a: self._gap(depth, a), fold_radius, hi, xtol=1e-15 * hi, rtol=1e-15)
+
+    def _radius_after(self, depth: float) -> float:
+        if self.radius > 0.0:
+            return self._outer_root(depth)
+        return self._outer_root(depth) if depth >= 0.0 else 0.0
+
+    # -- energies -----------------------------------------------------------------------
+    def _potential(self, depth: float, radius: float) -> float:
+        """Stored elastic energy minus surface energy w pi a^2, J."""
+        if radius <= 0.0:
+            return 0.0
+        profile = self.physics.profile
+        g = float(profile.g(radius))
+        g_int = float(profile.g_integral(radius))
+        g2_int = 0.0 if self.punch_radius is not None else radius * g * g / (2.0 * self.exponent + 1.0)
+        stored = self.physics.e0 * (depth * depth * radius - 2.0 * depth * g_int + g2_int)
+        return stored - self.physics.work_of_adhesion * math.pi * radius * radius
+
+    def force(self, depth: float, radius: float) -> float:
+        if radius <= 0.0:
+            return 0.0
+        return 2.0 * self.physics.e0 * (depth * radius - float(self.physics.profile.g_integral(radius)))
+
+    # -- model interface ----------------------------------------------------------------
+    def advance(self, d0: float, d1: float, dt: float) -> tuple[float, float, float]:
+        """Move from depth d0 to d1; returns (radius, force, work input J). Exact work: the
+        potential changes along the branch, F = 0 off it, jumps dissipate."""
+        r0 = self.radius
+        r1 = self._radius_after(d1)
+        if r0 > 0.0 and r1 > 0.0:
+            work = self._potential(d1, r1) - self._potential(d0, r0)
+        elif r0 > 0.0:
+            fold_radius, fold_depth = self._fold()
+            work = self._potential(fold_depth, fold_radius) - self._potential(d0, r0)
+        elif r1 > 0.0:
+            work = self._potential(d1, r1) - self._potential(0.0, self._outer_root(0.0))
+        else:
+            work = 0.0
+        self.radius = r1
+        return r1, self.force(d1, r1), work
+
+    def stored_energy(self, depth: float) -> float:
+        return self._potential(depth, self.radius) + self.physics.work_of_adhesion * math.pi * self.radius**2
+
+    def edge_gaps(self, depth: float) -> tuple[float, float]:
+        gap = self._gap(depth, self.radius)
+        return gap, gap
+
+    def is_relaxed(self) -> bool:
+        return True
+
+    def get_state(self) -> float:
+        return self.radius
+
+    def set_state(self, state: float) -> None:
+        self.radius = state
+
+    def reset(self) -> None:
+        self.radius = 0.0
+
+
+class _TimeStepped:
+    """The 1D MDR row of creep elements (see `_kernels`)."""
+
+    name = "time_stepped"
+
+    def __init__(self, physics: _Physics, numerics: ResolvedNumerics) -> None:
+        self.physics = physics
+        self.numerics = numerics
+        creep = physics.creep
+        e_kelvin = np.array([creep.modulus_star(g) for g in creep.kelvin_shear_moduli], dtype=np.float64)
+        # Dampers scale like springs: eta* = 2 eta / (1 - nu).
+        eta_kelvin = np.array([creep.modulus_star(v) for v in creep.kelvin_viscosities], dtype=np.float64)
+        self.e_kelvin = e_kelvin
+        self.rate = e_kelvin / eta_kelvin if e_kelvin.size else np.zeros(0)
+        self.p, self.p_inv, self.lam, self.beta = _modal_chain(physics.e0, e_kelvin, eta_kelvin)
+        self.punch_radius = getattr(physics.profile, "punch_radius", None)
+        if numerics.domain_radius > 0.0:
+            self.initial_length = numerics.domain_radius
+        elif self.punch_radius is not None:
+            self.initial_length = self.punch_radius
+        elif physics.work_of_adhesion > 0.0:
+            self.initial_length = 2.0 * physics.adhesion_length()
+        else:
+            self.initial_length = 0.0  # chosen from the depth at first contact
+        if self.punch_radius is not None:
+            self.initial_length = min(self.initial_length, self.punch_radius)
+        self.row: _kernels.Row | None = None
+        self.radius = 0.0
+        self.substeps = 0
+
+    # -- the domain ---------------------------------------------------------------------
+    def _build_row(self, length: float, memory: np.ndarray | None) -> _kernels.Row:
+        n = self.numerics.elements
+        m = n * self.numerics.fine_factor + 1
+        profile = self.physics.profile
+        reach = math.inf
+        if self.punch_radius is not None:
+            reach = self.punch_radius
+            length = min(length, reach)
+        dx = length / n
+        centres = (np.arange(n) + 0.5) * dx
+        fine = np.linspace(0.0, length, m)
+        k = self.e_kelvin.size
+        wl = np.zeros((n, k)) if memory is None else memory
+        return _kernels.Row(
+            dx=dx, g_c=np.asarray(profile.g(centres), dtype=np.float64),
+            gf=np.asarray(profile.g(fine), dtype=np.float64),
+            gint=np.asarray(profile.g_integral(fine), dtype=np.float64), df=fine[1], reach=reach,
+            wl=wl, p=self.p, p_inv=self.p_inv, lam=self.lam, beta=self.beta, rate=self.rate,
+            e_kelvin=self.e_kelvin,
+        )
+
+    def _grow(self) -> None:
+        """Grow the domain, remapping the memory (zero beyond the old domain: never touched)."""
+        row = self.row
+        assert row is not None
+        length = row.length * self.numerics.growth_factor
+        if length > 1e6 * max(self.initial_length, 1e-300) and length > 1e3:
+            raise InputError("the contact grows without bound (adhesion beats the profile's rise)")
+        centres = (np.arange(row.elements) + 0.5) * row.dx
+        new_centres = (np.arange(row.elements) + 0.5) * (length / row.elements)
+        memory = np.empty_like(row.wl)
+        for k in range(row.wl.shape[1]):
+            memory[:, k] = np.interp(new_centres, centres, row.wl[:, k], right=0.0)
+        self.row = self._build_row(length, memory)
+
+    def _ensure_row(self, depth: float) -> bool:
+        """Create the row if the indenter may touch; False if the step is trivially free."""
+        if self.row is not None:
+            return True
+        if depth < 0.0:
+            return False
+        length = self.initial_length
+        if length <= 0.0:
+            length = 1.25 * float(self.physics.profile.radius_at_height(depth))
+            if not length > 0.0:
+                return False
+        self.row = self._build_row(length, None)
+        return True
+
+    # -- model interface ----------------------------------------------------------------
+    def advance(self, d0: float, d1: float, dt: float) -> tuple[float, float, float]:
+        if not self._ensure_row(max(d0, d1)):
+            self.substeps = 0
+            return 0.0, 0.0, 0.0
+        assert self.row is not None
+        start = self.get_state()
+        while True:
+            row = self.row
+            status, out = _kernels.advance(
+                row, self.radius, d0, d1, dt, e0=self.physics.e0, c_crit=self.physics.c_crit,
+                max_substep=self.numerics.max_substep, max_edge_move=self.numerics.max_edge_cells * row.dx,
+            )
+            if status == _kernels.STATUS_OK:
+                break
+            self.set_state(start)
+            if self.row is None:
+                self.row = self._build_row(self.initial_length or 1.25 * float(
+                    self.physics.profile.radius_at_height(max(d0, d1))), None)
+            self._grow()
+            start = self.get_state()
+        self.radius = float(out[_kernels.OUT_RADIUS])
+        self.substeps = int(out[_kernels.OUT_SUBSTEPS])
+        return self.radius, float(out[_kernels.OUT_FORCE]), float(out[_kernels.OUT_WORK])
+
+    def stored_energy(self, depth: float) -> float:
+        if self.row is None:
+            return 0.0
+        return _kernels.stored_energy(self.row, self.radius, depth, self.physics.e0)
+
+    def edge_gaps(self, depth: float) -> tuple[float, float]:
+        """h at the edge with the exterior and with the interior memory, m."""
+        assert self.row is not None
+        c = self.physics.c_crit
+        return (
+            _kernels.criterion_gap(self.row, self.radius, depth, c, False, self.radius),
+            _kernels.criterion_gap(self.row, self.radius, depth, c, True, self.radius),
+        )
+
+    def is_relaxed(self) -> bool:
+        if self.row is None:
+            return True
+        if self.radius > 0.0:
+            return False
+        return float(np.max(np.abs(self.row.wsum), initial=0.0)) <= self.numerics.idle_tolerance * self.row.length
+
+    def drop_memory(self) -> None:
+        """Forget a relaxed, out-of-contact state: the next contact sizes a fresh domain."""
+        self.row = None
+
+    def get_state(self) -> tuple:
+        if self.row is None:
+            return (self.radius, None, None)
+        return (self.radius, self.row, self.row.wl.copy())
+
+    def set_state(self, state: tuple) -> None:
+        radius, row, memory = state
+        self.radius = radius
+        self.row = row
+        if row is not None:
+            row.set_memory(memory)
+
+    def reset(self) -> None:
+        self.radius = 0.0
+        self.row = None
+
+
+def _modal_chain(e0: float, e_kelvin: np.ndarray, eta_kelvin: np.ndarray) -> tuple[np.ndarray, ...]:
+    """Diagonalise the in-contact Kelvin chain once.
+
+    ``eta_k dl_k/dt = E0 (u - sum_j l_j) - E_k l_k`` is ``dl/dt = -D^-1 S l + D^-1 E0 1 u``
+    with ``S = E0 11^T + diag(E)`` (SPD) and ``D = diag(eta)``. With ``y = D^1/2 l`` the
+    matrix ``D^-1/2 S D^-1/2 = Q diag(lam) Q^T`` is symmetric positive definite, so the
+    modes ``z = Q^T D^1/2 l`` decouple with real rates ``lam > 0``:
+    ``dz/dt = -lam z + beta u``, ``beta = Q^T (E0 / sqrt(eta))``.
+    Returns ``(P, P_inv, lam, beta)`` with ``z = P l`` and ``l = P_inv z``.
+    """
+    k = e_kelvin.size
+    if k == 0:
+        empty = np.zeros((0, 0))
+        return empty, empty.copy(), np.zeros(0), np.zeros(0)
+    root = np.sqrt(eta_kelvin)
+    stiffness = e0 * np.ones((k, k)) + np.diag(e_kelvin)
+    lam, q = np.linalg.eigh(stiffness / np.outer(root, root))
+    p = np.ascontiguousarray(q.T * root[None, :])
+    p_inv = np.ascontiguousarray(q / root[:, None])
+    beta = np.ascontiguousarray(q.T @ (e0 / root))
+    return p, p_inv, np.ascontiguousarray(lam), beta
+
+
+@dataclass(frozen=True)
+class Snapshot:
+    """An opaque copy of a simulator's state (see `ContactSimulator.snapshot`)."""
+
+    model_state: Any
+    time: float
+    depth: float
+    output: StepOutput
+    energy_input: float
+
+
+class ContactSimulator:
+    """One adhesive viscoelastic contact, stepped in time.
+
+    contact: a ``ContactConfig`` (core/config.py): indenter, material, adhesion, numerics.
+    """
+
+    def __init__(self, contact: Any) -> None:
+        self.contact = contact
+        self.numerics = resolve_numerics(contact.numerics)
+        self.physics = _Physics(contact)
+        reason = _ClosedForm.eligible(self.physics)
+        requested = self.numerics.model
+        if requested == "closed_form" and reason:
+            raise ConfigError(f"numerics.model 'closed_form' is not available for this contact: {reason}")
+        if requested == "closed_form" or (requested == "auto" and not reason):
+            self._model: _ClosedForm | _TimeStepped = _ClosedForm(self.physics)
+        else:
+            self._model = _TimeStepped(self.physics, self.numerics)
+        self.reset(0.0)
+
+    # -- public state ---------------------------------------------------------------------
+    @property
+    def model(self) -> str:
+        """"closed_form" or "time_stepped": the model path computing this contact."""
+        return self._model.name
+
+    @property
+    def time(self) -> float:
+        return self._time
+
+    @property
+    def output(self) -> StepOutput:
+        """The last StepOutput (after `reset`, the rest state)."""
+        return self._output
+
+    @property
+    def in_contact(self) -> bool:
+        return self._output.contact_radius > 0.0
+
+    @property
+    def is_idle(self) -> bool:
+        """Out of contact with all memory relaxed: steps above the surface cost nothing."""
+        return not self.in_contact and self._model.is_relaxed()
+
+    def reset(self, time: float = 0.0) -> None:
+        """Back to the undeformed state at `time` (s), depth 0, no contact, energies zero."""
+        self._time = require_finite("time", time)
+        self._depth = 0.0
+        self._energy_input = 0.0
+        self._model.reset()
+        self._output = StepOutput(self._time, 0.0, 0.0, 0.0, Phase.NO_CONTACT, 0.0, 0.0, 0.0, 0.0, True, False)
+
+    def snapshot(self) -> Snapshot:
+        return Snapshot(self._model.get_state(), self._time, self._depth, self._output, self._energy_input)
+
+    def restore(self, snapshot: Snapshot) -> None:
+        self._model.set_state(snapshot.model_state)
+        self._time = snapshot.time
+        self._depth = snapshot.depth
+        self._output = snapshot.output
+        self._energy_input = snapshot.energy_input
+
+    # -- stepping -------------------------------------------------------------------------
+    def _check_time(self, time: float) -> float:
+        t = require_finite("time", time)
+        if t < self._time:
+            raise InputError(f"time must not go backwards (got {t!r} after {self._time!r})")
+        return t
+
+    def step(self, time: float, *, depth: float | None = None, force: float | None = None) -> StepOutput:
+        """Advance to `time` (s) under displacement control (`depth`, m) or force control
+        (`force`, N); exactly one of them. Returns the new StepOutput."""
+        t = self._check_time(time)
+        if (depth is None) == (force is None):
+            raise InputError("step needs exactly one of depth or force")
+        if depth is not None:
+            d = require_finite("depth", depth)
+            return self._move(t, d, unstable=False)
+        return self._solve_force(t, require_finite("force", force))
+
+    def advance(self, time: float) -> StepOutput:
+        """Hold the last control (the current depth) until `time` (s)."""
+        return self.step(time, depth=self._depth)
+
+    def _move(self, time: float, depth: float, *, unstable: bool) -> StepOutput:
+        """Advance the model from the current state to (time, depth) and publish the output."""
+        dt = time - self._time
+        r0 = self._output.contact_radius
+        if self.is_idle and depth < 0.0 and self._depth < 0.0:
+            radius, force, work = 0.0, 0.0, 0.0
+            if isinstance(self._model, _TimeStepped):
+                self._model.drop_memory()
+        else:
+            radius, force, work = self._model.advance(self._depth, depth, dt)
+        self._energy_input += work
+        self._time, self._depth = time, depth
+        self._output = self._make_output(time, depth, force, r0, radius, dt, unstable)
+        return self._output
+
+    def _make_output(self, time: float, depth: float, force: float, r0: float, radius: float,
+                     dt: float, unstable: bool) -> StepOutput:
+        physics = self.physics
+        if radius <= 0.0:
+            phase = Phase.NO_CONTACT
+        elif radius > r0:
+            phase = Phase.INDENTING
+        elif radius < r0:
+            phase = Phase.DETACHING
+        else:
+            # Pinned edge: say which criterion it rests on, if any (elastic contacts at
+            # rest sit on both; a punch rim blocks attachment).
+            tol = 1e-9 * (abs(depth) + physics.c_crit * math.sqrt(radius) + float(physics.profile.g(radius)))
+            outside, inside = self._model.edge_gaps(depth)
+            if outside >= -tol:
+                phase = Phase.INDENTING
+            elif inside <= tol:
+                phase = Phase.DETACHING
+            else:
+                phase = Phase.STICKING
+        edge_speed = (radius - r0) / dt if dt > 0.0 else 0.0
+        stored = self._model.stored_energy(depth)
+        dissipated = self._energy_input - stored + physics.work_of_adhesion * math.pi * radius * radius
+        return StepOutput(
+            time=time, depth=depth, force=force, contact_radius=radius, phase=phase,
+            edge_speed=edge_speed, effective_work_of_adhesion=physics.effective_work(depth, radius),
+            energy_input=self._energy_input, energy_dissipated=dissipated,
+            scale_separation_ok=physics.scale_separation_ok(edge_speed), unstable=unstable,
+        )
+
+    # -- force control ----------------------------------------------------------------------
+    def _stiffness_guess(self) -> float:
+        """A contact stiffness scale, N/m, to size the first bracketing step."""
+        radius = self._output.contact_radius
+        if radius <= 0.0:
+            row = getattr(self._model, "row", None)
+            radius = row.length if row is not None else getattr(self._model, "initial_length", 0.0)
+        if radius <= 0.0:
+            radius = max(self.physics.adhesion_length() if self.physics.work_of_adhesion > 0.0 else 0.0,
+                         abs(self._depth), 1e-9)
+        return 2.0 * self.physics.e_relaxed * radius
+
+    def _solve_force(self, time: float, target: float) -> StepOutput:
+        """Find the depth whose step from the current state gives `target` force (N)."""
+        start = self.snapshot()
+        d0 = self._depth
+        tol = self.numerics.force_tolerance * max(abs(target), abs(self._output.force), 1e-300)
+        was_in_contact = self.in_contact
+
+        def residual(depth: float) -> float:
+            self.restore(start)
+            return self._move(time, depth, unstable=False).force - target
+
+        r_hold = residual(d0)
+        if abs(r_hold) <= tol:
+            return self._output
+        direction = 1.0 if r_hold < 0.0 else -1.0
+        if direction < 0.0 and not self.in_contact and not was_in_contact:
+            # Out of contact and pulled away: no equilibrium, the indenter stays off.
+            self.restore(start)
+            return self._move(time, d0, unstable=target < 0.0)
+        delta = max(abs(r_hold) / self._stiffness_guess(), 1e-12 * (abs(d0) + 1e-12))
+        lo = d0
+        last_contact = d0
+        for _ in range(200):
+            hi = lo + direction * delta
+            r_hi = residual(hi)
+            if r_hi * direction >= 0.0:
+                break
+            if direction < 0.0 and not self.in_contact:
+                found = self._search_dip(residual, hi, last_contact)
+                if found is None:
+                    return self._pulled_off(residual, hi, last_contact, time)
+                hi, r_hi = found
+                break
+            last_contact = hi
+            lo = hi
+            delta *= 2.0
+        else:
+            raise InputError(f"force {target!r} N cannot be reached from depth {d0!r} m")
+        root = brentq(residual, min(lo, hi), max(lo, hi), xtol=1e-15 * max(abs(lo), abs(hi), 1e-300),
+                      rtol=1e-15, maxiter=200)
+        r_root = residual(root)
+        jumped_in = not was_in_contact and self.in_contact and self.physics.work_of_adhesion > 0.0
+        if abs(r_root) > max(tol, 1e-9 * abs(target)) or jumped_in:
+            # The force jumped across the target (snap-in or a discontinuous edge): no
+            # continuous equilibrium path; keep the physical state reached.
+            self.restore(start)
+            self._move(time, root, unstable=True)
+        return self._output
+
+    def _search_dip(self, residual, detached: float, attached: float) -> tuple[float, float] | None:
+        """Between an attached and a detached trial depth, look for a force below the target
+        that the bracketing step skipped (the minimum of F(d) lies before the fold)."""
+        lo, hi = detached, attached
+        best, r_best = attached, residual(attached)
+        for _ in range(60):
+            mid = 0.5 * (lo + hi)
+            r_mid = residual(mid)
+            if not self.in_contact:
+                lo = mid
+            else:
+                hi = mid
+                if r_mid < r_best:
+                    best, r_best = mid, r_mid
+                if r_mid <= 0.0:
+                    return mid, r_mid
+            if hi - lo <= 1e-13 * max(abs(hi), abs(lo), 1e-300):
+                break
+        # Golden-section on the attached interval for the force minimum.
+        a, b = hi, attached
+        golden = 0.5 * (math.sqrt(5.0) - 1.0)
+        for _ in range(60):
+            c = b - golden * (b - a)
+            d = a + golden * (b - a)
+            rc, rd = residual(c), residual(d)
+            for x, r in ((c, rc), (d, rd)):
+                if r <= 0.0:
+                    return x, r
+            if rc < rd:
+                b = d
+            else:
+                a = c
+            if abs(b - a) <= 1e-10 * max(abs(a), abs(b), 1e-300):
+                break
+        return None
+
+    def _pulled_off(self, residual, detached: float, attached: float, time: float) -> StepOutput:
+        """No equilibrium under force control: move to the detached state at the depth where
+        the contact let go, flagged unstable."""
+        lo, hi = detached, attached
+        for _ in range(60):
+            mid = 0.5 * (lo + hi)
+            residual(mid)
+            if self.in_contact:
+                hi = mid
+            else:
+                lo = mid
+            if hi - lo <= 1e-13 * max(abs(hi), abs(lo), 1e-300):
+                break
+        residual(lo)
+        output = self._output
+        self._output = StepOutput(**{**output.__dict__, "unstable": True})
+        return self._output
