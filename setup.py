@@ -14,6 +14,7 @@ setup(
         ("share/ament_index/resource_index/packages", [f"resource/{PACKAGE}"]),
         (f"share/{PACKAGE}", ["package.xml"]),
         (f"share/{PACKAGE}/config", sorted(glob("config/*.yaml"))),
+        (f"share/{PACKAGE}/config/examples", sorted(glob("config/examples/*.yaml"))),
     ],
     package_data={PACKAGE: ["py.typed"]},
     install_requires=["setuptools"],
@@ -26,7 +27,6 @@ setup(
     ),
     license="Apache-2.0",
     python_requires=">=3.10",
-    tests_require=["pytest"],
     entry_points={
         "console_scripts": [
             "viscoadh = viscoadh_ros.cli.main:main",
