@@ -68,7 +68,9 @@ def test_phase_constants_are_the_documented_values() -> None:
     [(IndentationCommand, _indentation_command), (ContactState, _contact_state)],
     ids=["IndentationCommand", "ContactState"],
 )
-def test_message_round_trip(ros_context: Any, ros_executor: Any, spin_until: Any, msg_type: type, make: Any) -> None:
+def test_message_round_trip(
+    ros_context: Any, ros_executor: Any, spin_until: Any, msg_type: type, make: Any
+) -> None:
     from rclpy.node import Node
 
     talker = Node("talker", context=ros_context)
@@ -88,7 +90,9 @@ def test_message_round_trip(ros_context: Any, ros_executor: Any, spin_until: Any
     assert received[0] == sent, f"{msg_type.__name__}: received {received[0]} != sent {sent}"
 
 
-def _serve_and_call(ros_context: Any, executor: Any, spin_until: Any, srv_type: type, handler: Any, request: Any) -> Any:
+def _serve_and_call(
+    ros_context: Any, executor: Any, spin_until: Any, srv_type: type, handler: Any, request: Any
+) -> Any:
     from rclpy.node import Node
 
     server = Node("server", context=ros_context)
@@ -104,7 +108,9 @@ def _serve_and_call(ros_context: Any, executor: Any, spin_until: Any, srv_type: 
 
 
 def test_simulate_history_service_round_trip(ros_context: Any, ros_executor: Any, spin_until: Any) -> None:
-    def handler(request: SimulateHistory.Request, response: SimulateHistory.Response) -> SimulateHistory.Response:
+    def handler(
+        request: SimulateHistory.Request, response: SimulateHistory.Response
+    ) -> SimulateHistory.Response:
         # Echo shapes and values back through every response field, so each one is carried.
         response.depth = [2.0 * d for d in request.depth]
         response.force = [t + 1.0 for t in request.time]
@@ -114,19 +120,27 @@ def test_simulate_history_service_round_trip(ros_context: Any, ros_executor: Any
         response.message = f"{len(request.time)} samples"
         return response
 
-    request = SimulateHistory.Request(mode=SimulateHistory.Request.FORCE, time=[0.0, 0.5, 1.0],
-                                      depth=[0.0, 1e-6, 4e-6], force=[0.0, 1e-3, 2e-3])
+    request = SimulateHistory.Request(
+        mode=SimulateHistory.Request.FORCE,
+        time=[0.0, 0.5, 1.0],
+        depth=[0.0, 1e-6, 4e-6],
+        force=[0.0, 1e-3, 2e-3],
+    )
     response = _serve_and_call(ros_context, ros_executor, spin_until, SimulateHistory, handler, request)
 
     assert response.success and response.message == "3 samples", "SimulateHistory: status"
     assert list(response.depth) == [0.0, 2e-6, 8e-6], "SimulateHistory: depth"
     assert list(response.force) == [1.0, 1.5, 2.0], "SimulateHistory: force"
-    assert list(response.contact_radius) == pytest.approx([0.0, 1e-3, 2e-3], rel=1e-12), "SimulateHistory: radius"
+    assert list(response.contact_radius) == pytest.approx([0.0, 1e-3, 2e-3], rel=1e-12), (
+        "SimulateHistory: radius"
+    )
     assert list(response.phase) == [1, 1, 1], "SimulateHistory: phase"
 
 
 def test_predict_pull_off_service_round_trip(ros_context: Any, ros_executor: Any, spin_until: Any) -> None:
-    def handler(request: PredictPullOff.Request, response: PredictPullOff.Response) -> PredictPullOff.Response:
+    def handler(
+        request: PredictPullOff.Request, response: PredictPullOff.Response
+    ) -> PredictPullOff.Response:
         response.pull_off_force = -request.retract_speed * 10.0
         response.pull_off_depth = -request.retract_speed
         response.time_to_detach = 1.0 / request.retract_speed
@@ -138,12 +152,15 @@ def test_predict_pull_off_service_round_trip(ros_context: Any, ros_executor: Any
     response = _serve_and_call(ros_context, ros_executor, spin_until, PredictPullOff, handler, request)
 
     assert response.success and response.message == "ok", "PredictPullOff: status"
-    assert (response.pull_off_force, response.pull_off_depth) == (-1e-3, -1e-4), "PredictPullOff: force, depth"
+    assert (response.pull_off_force, response.pull_off_depth) == (-1e-3, -1e-4), (
+        "PredictPullOff: force, depth"
+    )
     assert response.time_to_detach == pytest.approx(1e4, rel=1e-12), "PredictPullOff: time_to_detach"
 
 
-def test_message_reaches_a_child_process(ros_localhost_context: Any, ros_env: dict[str, str],
-                                         spin_until: Any) -> None:
+def test_message_reaches_a_child_process(
+    ros_localhost_context: Any, ros_env: dict[str, str], spin_until: Any
+) -> None:
     """A ContactState published by a child process arrives here: ros_env and LOCALHOST work."""
     from rclpy.executors import SingleThreadedExecutor
     from rclpy.node import Node
@@ -182,10 +199,13 @@ def test_message_reaches_a_child_process(ros_localhost_context: Any, ros_env: di
 
 
 def test_messages_import_with_no_ros_environment() -> None:
-    code = ("from viscoadh_msgs.msg import ContactState, IndentationCommand; "
-            "from viscoadh_msgs.srv import SimulateHistory, PredictPullOff; print(ContactState.DETACHING)")
-    done = subprocess.run([sys.executable, "-c", code], env={}, cwd="/", capture_output=True, text=True,
-                          timeout=60)
+    code = (
+        "from viscoadh_msgs.msg import ContactState, IndentationCommand; "
+        "from viscoadh_msgs.srv import SimulateHistory, PredictPullOff; print(ContactState.DETACHING)"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", code], env={}, cwd="/", capture_output=True, text=True, timeout=60
+    )
     assert done.returncode == 0, f"import with an empty environment failed:\n{done.stderr}"
     assert done.stdout.strip() == "3", "ContactState.DETACHING from a bare environment"
 
@@ -193,8 +213,9 @@ def test_messages_import_with_no_ros_environment() -> None:
 def test_cli_help_lists_every_verb() -> None:
     from viscoadh_ros.cli.main import VERBS
 
-    done = subprocess.run([str(BIN / "viscoadh"), "--help"], env={}, cwd="/", capture_output=True, text=True,
-                          timeout=60)
+    done = subprocess.run(
+        [str(BIN / "viscoadh"), "--help"], env={}, cwd="/", capture_output=True, text=True, timeout=60
+    )
     assert done.returncode == 0, f"viscoadh --help failed:\n{done.stderr}"
     for verb in VERBS:
         assert f"\n    {verb} " in done.stdout, f"verb {verb!r} missing from viscoadh --help"

@@ -135,4 +135,3 @@ def main(argv: Sequence[str] | None = None) -> int:
             print(f"{PROG} {args.verb}: error: {exc}", file=sys.stderr)
             return 2
         raise
-
