@@ -182,3 +182,9 @@ def test_file_errors_are_config_errors(tmp_path):
         SceneConfig.from_yaml(bad)
     with pytest.raises(ConfigError, match=r"no contact 'thumb' in the scene \(contacts: finger\)"):
         SceneConfig.from_dict(BARE).contact("thumb")
+
+
+def test_every_key_is_documented():
+    text = (Path(__file__).resolve().parents[1] / "docs" / "configuration.md").read_text(encoding="utf-8")
+    for key in ["contacts", *NODE_KEYS, *(k.split(".", 1)[1] for k in CONTACT_KEYS)]:
+        assert f"| `{key}` |" in text, f"docs/configuration.md does not document {key}"
