@@ -469,6 +469,13 @@ def run_demo(
         driver = _Driver(client, contact.id, timeout=_TIMEOUT_S)
         driver.wait_for_node()
         run = drive_cycle(driver, plan)
+    # The node finished its log when it was destroyed, on leaving the block.
+    if not log_path.is_file():
+        raise RuntimeError(f"the node wrote no log to {log_path} (log.enabled is set)")
     summary = summarize(run, reference)
-    plot_run(run, reference, figure_path, title=f"viscoadh demo: contact '{contact.id}'")
+    title = (
+        f"viscoadh demo, contact '{contact.id}': in and out at "
+        f"{_si(plan.approach_speed, 'm/s')}, hold {plan.hold_time:.3g} s"
+    )
+    plot_run(run, reference, figure_path, title=title)
     return format_summary(summary, {"log": log_path, "figure": figure_path})
