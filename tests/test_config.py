@@ -24,7 +24,11 @@ BARE = {
     "contacts": ["finger"],
     "finger": {
         "indenter": {"shape": "sphere", "radius": 2e-3},
-        "material": {"glass_shear_modulus": 1e6, "kelvin_shear_moduli": [1e4, 3e5], "kelvin_viscosities": [1e3, 30.0]},
+        "material": {
+            "glass_shear_modulus": 1e6,
+            "kelvin_shear_moduli": [1e4, 3e5],
+            "kelvin_viscosities": [1e3, 30.0],
+        },
         "adhesion": {"work_of_adhesion": 0.05},
     },
     "log": {"enabled": True, "path": "/tmp/run.mcap"},
@@ -77,7 +81,9 @@ def test_three_forms_give_the_same_scene():
 
 def test_to_parameters_types_are_ros_compatible():
     flat = SceneConfig.from_dict(scene_with(finger__material={"glass_shear_modulus": 1e6})).to_parameters()
-    assert flat["finger.material.kelvin_shear_moduli"] == []  # K = 0: empty list, declared DOUBLE_ARRAY by the node
+    assert (
+        flat["finger.material.kelvin_shear_moduli"] == []
+    )  # K = 0: empty list, declared DOUBLE_ARRAY by the node
     for key, value in flat.items():
         assert isinstance(value, (bool, int, float, str, list)), key
         if isinstance(value, list) and key != "contacts":
@@ -99,7 +105,8 @@ def test_rclpy_value_types_are_accepted():
 def test_yaml_floats_read_like_ros(tmp_path):
     path = tmp_path / "s.yaml"
     path.write_text(
-        "contacts: [c]\nc:\n  indenter: {shape: sphere, radius: 2e-3}\n  material: {glass_shear_modulus: 1.0e6}\n",
+        "contacts: [c]\nc:\n  indenter: {shape: sphere, radius: 2e-3}\n"
+        "  material: {glass_shear_modulus: 1.0e6}\n",
         encoding="utf-8",
     )
     contact = SceneConfig.from_yaml(path).contact("c")
@@ -108,7 +115,13 @@ def test_yaml_floats_read_like_ros(tmp_path):
 
 def test_prony_material_is_converted_exactly_and_keeps_its_form():
     scene = SceneConfig.from_dict(
-        scene_with(finger__material={"prony_long_term_modulus": 2e4, "prony_moduli": [5e5, 1e5], "prony_times": [1e-3, 2.0]})
+        scene_with(
+            finger__material={
+                "prony_long_term_modulus": 2e4,
+                "prony_moduli": [5e5, 1e5],
+                "prony_times": [1e-3, 2.0],
+            }
+        )
     )
     material = scene.contact("finger").material
     element = prony_to_creep(2e4, [5e5, 1e5], [1e-3, 2.0])
@@ -122,7 +135,9 @@ def test_prony_material_is_converted_exactly_and_keeps_its_form():
 
 
 def test_keys_of_other_shapes_are_ignored_and_dropped():
-    scene = SceneConfig.from_dict(scene_with(finger__indenter={"shape": "cone", "half_angle": 1.2, "radius": 5e-3}))
+    scene = SceneConfig.from_dict(
+        scene_with(finger__indenter={"shape": "cone", "half_angle": 1.2, "radius": 5e-3})
+    )
     indenter = scene.contact("finger").indenter
     assert indenter.half_angle == 1.2 and indenter.radius == 0.0
     assert "finger.indenter.radius" not in scene.to_parameters()
@@ -131,19 +146,52 @@ def test_keys_of_other_shapes_are_ignored_and_dropped():
 @pytest.mark.parametrize(
     ("changes", "match"),
     [
-        ({"finger__material__kelvin_viscosities": [1e3, -3.0]}, r"^finger\.material\.kelvin_viscosities\[1\] must be > 0"),
-        ({"finger__material__kelvin_viscosities": [1e3]}, r"finger\.material\.kelvin_shear_moduli and .* same length"),
-        ({"finger__material__glass_shear_modulus": float("nan")}, r"^finger\.material\.glass_shear_modulus must be finite"),
-        ({"finger__material__glass_shear_modulus": "1e6"}, r"^finger\.material\.glass_shear_modulus must be a number"),
-        ({"finger__material__glass_shear_modulus": None}, r"^finger\.material\.glass_shear_modulus is required"),
-        ({"finger__material__poisson_ratio": 0.6}, r"^finger\.material\.poisson_ratio must be in \[0, 0\.5\]"),
-        ({"finger__material__prony_times": [1.0]}, r"finger\.material: give either the Kelvin chain .* not both"),
-        ({"finger__material__glass_shear_modulu": 1e6}, r"did you mean 'finger\.material\.glass_shear_modulus'"),
+        (
+            {"finger__material__kelvin_viscosities": [1e3, -3.0]},
+            r"^finger\.material\.kelvin_viscosities\[1\] must be > 0",
+        ),
+        (
+            {"finger__material__kelvin_viscosities": [1e3]},
+            r"finger\.material\.kelvin_shear_moduli and .* same length",
+        ),
+        (
+            {"finger__material__glass_shear_modulus": float("nan")},
+            r"^finger\.material\.glass_shear_modulus must be finite",
+        ),
+        (
+            {"finger__material__glass_shear_modulus": "1e6"},
+            r"^finger\.material\.glass_shear_modulus must be a number",
+        ),
+        (
+            {"finger__material__glass_shear_modulus": None},
+            r"^finger\.material\.glass_shear_modulus is required",
+        ),
+        (
+            {"finger__material__poisson_ratio": 0.6},
+            r"^finger\.material\.poisson_ratio must be in \[0, 0\.5\]",
+        ),
+        (
+            {"finger__material__prony_times": [1.0]},
+            r"finger\.material: give either the Kelvin chain .* not both",
+        ),
+        (
+            {"finger__material__glass_shear_modulu": 1e6},
+            r"did you mean 'finger\.material\.glass_shear_modulus'",
+        ),
         ({"finger__indenter__radius": None}, r"^finger\.indenter\.radius is required for shape 'sphere'"),
-        ({"finger__indenter": {"shape": "cone", "half_angle": 2.0}}, r"^finger\.indenter\.half_angle must be < pi/2"),
+        (
+            {"finger__indenter": {"shape": "cone", "half_angle": 2.0}},
+            r"^finger\.indenter\.half_angle must be < pi/2",
+        ),
         ({"finger__indenter": {"shape": "cube"}}, r"^finger\.indenter\.shape must be one of"),
         (
-            {"finger__indenter": {"shape": "table", "table_radius": [0.0, 1e-3, 2e-3], "table_height": [0.0, 2e-6, 1e-6]}},
+            {
+                "finger__indenter": {
+                    "shape": "table",
+                    "table_radius": [0.0, 1e-3, 2e-3],
+                    "table_height": [0.0, 2e-6, 1e-6],
+                }
+            },
             r"^finger\.indenter\.table_height must be non-decreasing",
         ),
         ({"finger__adhesion__work_of_adhesion": -0.1}, r"^finger\.adhesion\.work_of_adhesion must be >= 0"),
@@ -157,7 +205,10 @@ def test_keys_of_other_shapes_are_ignored_and_dropped():
         ({"contacts": ["finger", "log"]}, r"contacts\[1\] 'log' is reserved"),
         ({"contacts": "finger"}, r"^contacts must be a list"),
         ({"contacts": None}, r"^contacts is required"),
-        ({"thumb": {"indenter": {"shape": "sphere"}}}, r"^thumb\.indenter\.shape: contact 'thumb' is not listed in contacts"),
+        (
+            {"thumb": {"indenter": {"shape": "sphere"}}},
+            r"^thumb\.indenter\.shape: contact 'thumb' is not listed in contacts",
+        ),
         ({"publish_rate": 0.0}, r"^publish_rate must be > 0"),
         ({"publish_rte": 10.0}, r"unknown parameter 'publish_rte' \(did you mean 'publish_rate'\?\)"),
         ({"markers": {"enabled": "yes"}}, r"^markers\.enabled must be true or false"),

@@ -54,8 +54,7 @@ def test_g_integral_and_inverse(name):
     profile = ANALYTIC[name]
     a = np.array([1e-5, 2e-4, 1.5e-3])
     expected = [
-        integrate.quad(lambda x: float(profile.g(x)), 0, v, epsabs=0, epsrel=1e-12, limit=200)[0]
-        for v in a
+        integrate.quad(lambda x: float(profile.g(x)), 0, v, epsabs=0, epsrel=1e-12, limit=200)[0] for v in a
     ]
     np.testing.assert_allclose(profile.g_integral(a), expected, rtol=1e-9, err_msg=name)
     np.testing.assert_allclose(profile.radius_at_height(profile.g(a)), a, rtol=1e-12, err_msg=name)

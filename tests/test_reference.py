@@ -25,7 +25,10 @@ SPHERES = [(2e-3, 4e6, 0.05), (1e-6, 1e9, 1e-3), (0.5, 1e5, 10.0)]
 
 def standard_solid(g0=1e6, g1=1e4, eta1=1e3, nu=0.5) -> CreepElement:
     return CreepElement(
-        glass_shear_modulus=g0, kelvin_shear_moduli=np.array([g1]), kelvin_viscosities=np.array([eta1]), poisson_ratio=nu
+        glass_shear_modulus=g0,
+        kelvin_shear_moduli=np.array([g1]),
+        kelvin_viscosities=np.array([eta1]),
+        poisson_ratio=nu,
     )
 
 
@@ -35,7 +38,10 @@ def test_jkr_without_adhesion_is_hertz(radius, modulus, work):
     depth = ref.jkr_depth(a, radius, modulus, 0.0)
     np.testing.assert_allclose(ref.hertz_radius(depth, radius), a, rtol=1e-12, err_msg=f"R={radius}")
     np.testing.assert_allclose(
-        ref.jkr_force(a, radius, modulus, 0.0), ref.hertz_force(depth, radius, modulus), rtol=1e-12, err_msg=f"R={radius}"
+        ref.jkr_force(a, radius, modulus, 0.0),
+        ref.hertz_force(depth, radius, modulus),
+        rtol=1e-12,
+        err_msg=f"R={radius}",
     )
 
 
@@ -43,8 +49,12 @@ def test_jkr_without_adhesion_is_hertz(radius, modulus, work):
 def test_general_mdr_curve_is_jkr_for_a_sphere(radius, modulus, work):
     a = np.linspace(0.0, 1e-2 * radius, 21)
     depth, force = ref.mdr_adhesive_curve(Sphere(radius=radius), a, modulus, work)
-    np.testing.assert_allclose(depth, ref.jkr_depth(a, radius, modulus, work), rtol=1e-12, atol=1e-25, err_msg="depth")
-    np.testing.assert_allclose(force, ref.jkr_force(a, radius, modulus, work), rtol=1e-12, atol=1e-25, err_msg="force")
+    np.testing.assert_allclose(
+        depth, ref.jkr_depth(a, radius, modulus, work), rtol=1e-12, atol=1e-25, err_msg="depth"
+    )
+    np.testing.assert_allclose(
+        force, ref.jkr_force(a, radius, modulus, work), rtol=1e-12, atol=1e-25, err_msg="force"
+    )
 
 
 def test_general_mdr_curve_without_adhesion_is_sneddon_and_power_law():
@@ -52,7 +62,9 @@ def test_general_mdr_curve_without_adhesion_is_sneddon_and_power_law():
     d = np.array([1e-6, 1e-5, 3e-4])
     depth, force = ref.mdr_adhesive_curve(cone, ref.sneddon_cone_radius(d, cone.half_angle), 2e6, 0.0)
     np.testing.assert_allclose(depth, d, rtol=1e-12, err_msg="cone depth")
-    np.testing.assert_allclose(force, ref.sneddon_cone_force(d, cone.half_angle, 2e6), rtol=1e-12, err_msg="Sneddon")
+    np.testing.assert_allclose(
+        force, ref.sneddon_cone_force(d, cone.half_angle, 2e6), rtol=1e-12, err_msg="Sneddon"
+    )
     # power law n = 2 is the sphere: Hertz
     law = PowerLaw(coefficient=1 / (2 * 3e-3), exponent=2.0)
     depth, force = ref.mdr_adhesive_curve(law, ref.hertz_radius(d, 3e-3), 2e6, 0.0)
@@ -79,7 +91,9 @@ def test_pull_off_points_are_extrema_of_the_parametric_curves(radius, modulus, w
         a = point.contact_radius * np.array([0.999, 1.0, 1.001])
         values = curve(a, radius, modulus, work)
         assert values[1] < values[0] and values[1] < values[2], f"{curve.__name__} has no minimum at a={a[1]}"
-    assert force_point.depth == pytest.approx(float(ref.jkr_depth(force_point.contact_radius, radius, modulus, work)))
+    assert force_point.depth == pytest.approx(
+        float(ref.jkr_depth(force_point.contact_radius, radius, modulus, work))
+    )
 
 
 def test_figure4_scales_are_the_relaxed_pull_off_point():
@@ -98,12 +112,18 @@ def test_first_touch_is_glassy_jkr_at_zero_depth():
     radius, work = 3e-3, 0.04
     touch = ref.first_touch(radius, work, element)
     e0 = element.glass_modulus_star
-    assert float(ref.jkr_depth(touch.neck_radius, radius, e0, work)) == pytest.approx(0.0, abs=1e-12 * touch.neck_radius)
-    assert float(ref.jkr_force(touch.neck_radius, radius, e0, work)) == pytest.approx(touch.force_drop, rel=1e-12)
+    assert float(ref.jkr_depth(touch.neck_radius, radius, e0, work)) == pytest.approx(
+        0.0, abs=1e-12 * touch.neck_radius
+    )
+    assert float(ref.jkr_force(touch.neck_radius, radius, e0, work)) == pytest.approx(
+        touch.force_drop, rel=1e-12
+    )
     w1 = work_of_adhesion_indenting(work, element)
     assert touch.relaxed_force == pytest.approx(-4.0 / 3.0 * math.pi * radius * w1, rel=1e-12)
     incompressible = ref.first_touch(radius, work, standard_solid())
-    assert incompressible.neck_radius == pytest.approx((math.pi * radius**2 * work / (2 * 1e6)) ** (1 / 3), rel=1e-12)
+    assert incompressible.neck_radius == pytest.approx(
+        (math.pi * radius**2 * work / (2 * 1e6)) ** (1 / 3), rel=1e-12
+    )
 
 
 @pytest.mark.parametrize("nu", [0.5, 0.3])
@@ -117,10 +137,18 @@ def test_lee_radok_ramp_against_quadrature(nu):
     radius, velocity = 2e-3, 1e-4
 
     def quadrature(t: float) -> float:
-        rate = lambda s: 1.5 * (radius * velocity) ** 1.5 * math.sqrt(s)  # d(a^3)/ds
+        def rate(s: float) -> float:  # d(a^3)/ds
+            return 1.5 * (radius * velocity) ** 1.5 * math.sqrt(s)
+
         points = [max(t - k * tau, 0.0) for tau in element.relaxation_times for k in (1, 5)]
         value = integrate.quad(
-            lambda s: float(element.relaxation_modulus(t - s)) * rate(s), 0, t, points=points, epsabs=0, epsrel=1e-12, limit=400
+            lambda s: float(element.relaxation_modulus(t - s)) * rate(s),
+            0,
+            t,
+            points=points,
+            epsabs=0,
+            epsrel=1e-12,
+            limit=400,
         )[0]
         return 8.0 / (3.0 * (1.0 - nu) * radius) * value
 

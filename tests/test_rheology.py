@@ -44,10 +44,10 @@ def boltzmann_identity(e: CreepElement, t: np.ndarray) -> np.ndarray:
     p = e.prony
     retard = e.retardation_times
     total = p(t) / e.glass_shear_modulus
-    for g_k, t_k in zip(e.kelvin_shear_moduli, retard):
+    for g_k, t_k in zip(e.kelvin_shear_moduli, retard, strict=True):
         rate = 1.0 / (g_k * t_k)  # J'(s) = rate * exp(-s/t_k)
         total = total + p.long_term_modulus * rate * t_k * -np.expm1(-t / t_k)
-        for g_i, tau_i in zip(p.moduli, p.times):
+        for g_i, tau_i in zip(p.moduli, p.times, strict=True):
             kernel = (np.exp(-t / t_k) - np.exp(-t / tau_i)) / (1.0 / tau_i - 1.0 / t_k)
             total = total + g_i * rate * kernel
     return total
@@ -61,7 +61,10 @@ def test_relaxation_modulus_matches_state_space(name, rtol):
     e = element(name)
     t = np.concatenate([[0.0], np.logspace(-8, 7, 46)])
     np.testing.assert_allclose(
-        e.relaxation_modulus(t), relaxation_by_state_space(e, t), rtol=rtol, atol=1e-12 * e.glass_shear_modulus,
+        e.relaxation_modulus(t),
+        relaxation_by_state_space(e, t),
+        rtol=rtol,
+        atol=1e-12 * e.glass_shear_modulus,
         err_msg=f"relaxation modulus {name}",
     )
 
@@ -73,7 +76,9 @@ def test_relaxation_and_creep_are_inverse(name):
     np.testing.assert_allclose(boltzmann_identity(e, t), 1.0, rtol=1e-11, err_msg=f"G*dJ = 1 for {name}")
     np.testing.assert_allclose(e.relaxation_modulus(0.0), e.glass_shear_modulus, rtol=1e-12, err_msg=name)
     np.testing.assert_allclose(e.relaxation_modulus(1e12), e.relaxed_shear_modulus, rtol=1e-12, err_msg=name)
-    np.testing.assert_allclose(e.creep_compliance(1e12), 1.0 / e.relaxed_shear_modulus, rtol=1e-12, err_msg=name)
+    np.testing.assert_allclose(
+        e.creep_compliance(1e12), 1.0 / e.relaxed_shear_modulus, rtol=1e-12, err_msg=name
+    )
 
 
 @pytest.mark.parametrize("name", sorted(MATERIALS))
@@ -84,7 +89,9 @@ def test_prony_round_trip_and_interlacing(name):
     order = np.argsort(e.retardation_times)[::-1]
     np.testing.assert_allclose(back.glass_shear_modulus, e.glass_shear_modulus, rtol=1e-12, err_msg=name)
     np.testing.assert_allclose(back.retardation_times, e.retardation_times[order], rtol=1e-10, err_msg=name)
-    np.testing.assert_allclose(back.kelvin_shear_moduli, e.kelvin_shear_moduli[order], rtol=1e-9, err_msg=name)
+    np.testing.assert_allclose(
+        back.kelvin_shear_moduli, e.kelvin_shear_moduli[order], rtol=1e-9, err_msg=name
+    )
     # T_1 > tau_1 > T_2 > tau_2 > ...
     merged = np.empty(2 * e.kelvin_count)
     merged[0::2], merged[1::2] = back.retardation_times, p.times
@@ -93,7 +100,9 @@ def test_prony_round_trip_and_interlacing(name):
 
 def test_standard_solid_matches_physics_notes():
     g0, g1, eta1 = 1e9, 1e7, 1e4
-    e = CreepElement(glass_shear_modulus=g0, kelvin_shear_moduli=np.array([g1]), kelvin_viscosities=np.array([eta1]))
+    e = CreepElement(
+        glass_shear_modulus=g0, kelvin_shear_moduli=np.array([g1]), kelvin_viscosities=np.array([eta1])
+    )
     g_inf, tau = g0 * g1 / (g0 + g1), eta1 / (g0 + g1)
     assert e.relaxed_shear_modulus == pytest.approx(g_inf, rel=1e-14)
     np.testing.assert_allclose(e.prony.times, [tau], rtol=1e-13)
@@ -117,7 +126,9 @@ def test_moduli_star_and_elastic_element():
 
 def test_equal_times_are_merged():
     twin = CreepElement(
-        glass_shear_modulus=1e6, kelvin_shear_moduli=np.array([1e5, 3e5]), kelvin_viscosities=np.array([1e3, 3e3])
+        glass_shear_modulus=1e6,
+        kelvin_shear_moduli=np.array([1e5, 3e5]),
+        kelvin_viscosities=np.array([1e3, 3e3]),
     )
     single = CreepElement(
         glass_shear_modulus=1e6, kelvin_shear_moduli=np.array([7.5e4]), kelvin_viscosities=np.array([7.5e2])
@@ -130,7 +141,10 @@ def test_equal_times_are_merged():
 @settings(max_examples=60, deadline=None)
 @given(
     st.lists(
-        st.tuples(st.floats(-3.0, 3.0), st.floats(-6.0, 4.0)), min_size=1, max_size=4, unique_by=lambda v: round(v[1], 2)
+        st.tuples(st.floats(-3.0, 3.0), st.floats(-6.0, 4.0)),
+        min_size=1,
+        max_size=4,
+        unique_by=lambda v: round(v[1], 2),
     ),
     st.floats(-2.0, 2.0),
 )
@@ -142,15 +156,23 @@ def test_prony_conversion_reproduces_relaxation_modulus(terms, log_ratio):
     e = prony_to_creep(g_inf, moduli, times)
     t = np.concatenate([[0.0], np.logspace(-8, 6, 29)])
     expected = g_inf + np.exp(-t[:, None] / times) @ moduli
-    np.testing.assert_allclose(e.relaxation_modulus(t), expected, rtol=1e-9, err_msg=f"{terms}, G_inf={g_inf}")
+    np.testing.assert_allclose(
+        e.relaxation_modulus(t), expected, rtol=1e-9, err_msg=f"{terms}, G_inf={g_inf}"
+    )
 
 
 @pytest.mark.parametrize(
     ("kwargs", "match"),
     [
         ({"glass_shear_modulus": -1.0}, r"material.glass_shear_modulus must be > 0"),
-        ({"kelvin_shear_moduli": [1e4, 1e5], "kelvin_viscosities": [1.0, -3.0]}, r"kelvin_viscosities\[1\] must be > 0"),
-        ({"kelvin_shear_moduli": [np.nan], "kelvin_viscosities": [1.0]}, r"kelvin_shear_moduli\[0\] must be finite"),
+        (
+            {"kelvin_shear_moduli": [1e4, 1e5], "kelvin_viscosities": [1.0, -3.0]},
+            r"kelvin_viscosities\[1\] must be > 0",
+        ),
+        (
+            {"kelvin_shear_moduli": [np.nan], "kelvin_viscosities": [1.0]},
+            r"kelvin_shear_moduli\[0\] must be finite",
+        ),
         ({"kelvin_shear_moduli": [1e4], "kelvin_viscosities": [1.0, 2.0]}, r"same length"),
         ({"poisson_ratio": 0.6}, r"material.poisson_ratio must be in \[0, 0.5\]"),
     ],

@@ -170,7 +170,12 @@ class NodeConfig:
 
 # --- schema: flat key -> (section dataclass field, kind) ------------------------------------
 
-_SECTIONS = {"indenter": IndenterConfig, "material": MaterialConfig, "adhesion": AdhesionConfig, "numerics": NumericsConfig}
+_SECTIONS = {
+    "indenter": IndenterConfig,
+    "material": MaterialConfig,
+    "adhesion": AdhesionConfig,
+    "numerics": NumericsConfig,
+}
 _KIND_OF_TYPE = {"float": "float", "int": "int", "str": "str", "bool": "bool", "tuple[float, ...]": "floats"}
 
 
@@ -184,7 +189,8 @@ CONTACT_KEYS: dict[str, str] = {
 }
 #: node-level keys: "publish_rate" -> "float", "markers.enabled" -> "bool", ...
 NODE_KEYS: dict[str, str] = {
-    name.replace("markers_", "markers.").replace("log_", "log.", 1): kind for name, kind in _kinds(NodeConfig).items()
+    name.replace("markers_", "markers.").replace("log_", "log.", 1): kind
+    for name, kind in _kinds(NodeConfig).items()
 }
 _SHAPE_KEYS = {
     "sphere": ("radius",),
@@ -283,7 +289,9 @@ def _build_contact(contact_id: str, given: dict[str, Any]) -> ContactConfig:
         raise ConfigError(f"{contact_id}.indenter.shape is required (one of {', '.join(_SHAPE_KEYS)})")
     shape = indenter["shape"]
     if shape not in _SHAPE_KEYS:
-        raise ConfigError(f"{contact_id}.indenter.shape must be one of {', '.join(_SHAPE_KEYS)} (got {shape!r})")
+        raise ConfigError(
+            f"{contact_id}.indenter.shape must be one of {', '.join(_SHAPE_KEYS)} (got {shape!r})"
+        )
     for name in _SHAPE_KEYS[shape]:
         if name not in indenter:
             raise ConfigError(f"{contact_id}.indenter.{name} is required for shape {shape!r}")
@@ -338,7 +346,11 @@ def _build_contact(contact_id: str, given: dict[str, Any]) -> ContactConfig:
         prony_times=material.get("prony_times", ()),
     )
     return ContactConfig(
-        id=contact_id, indenter=indenter_config, material=material_config, adhesion=adhesion, numerics=numerics
+        id=contact_id,
+        indenter=indenter_config,
+        material=material_config,
+        adhesion=adhesion,
+        numerics=numerics,
     )
 
 
@@ -366,7 +378,9 @@ class _RosYamlLoader(yaml.SafeLoader):
 
 _RosYamlLoader.add_implicit_resolver(
     "tag:yaml.org,2002:float",
-    re.compile(r"^[-+]?(?:[0-9][0-9_]*\.[0-9_]*|\.[0-9_]+|[0-9][0-9_]*)(?:[eE][-+]?[0-9]+)$|^[-+]?(?:[0-9][0-9_]*\.[0-9_]*|\.[0-9_]+)$|^[-+]?\.(?:inf|Inf|INF)$|^\.(?:nan|NaN|NAN)$"),
+    re.compile(
+        r"^[-+]?(?:[0-9][0-9_]*\.[0-9_]*|\.[0-9_]+|[0-9][0-9_]*)(?:[eE][-+]?[0-9]+)$|^[-+]?(?:[0-9][0-9_]*\.[0-9_]*|\.[0-9_]+)$|^[-+]?\.(?:inf|Inf|INF)$|^\.(?:nan|NaN|NAN)$"
+    ),
     list("-+0123456789."),
 )
 
@@ -379,7 +393,7 @@ class SceneConfig:
     node: NodeConfig = NodeConfig()
 
     @classmethod
-    def from_parameters(cls, flat: Mapping[str, Any]) -> "SceneConfig":
+    def from_parameters(cls, flat: Mapping[str, Any]) -> SceneConfig:
         """From flat dotted parameters (``{"contacts": [...], "finger.indenter.shape": ...}``).
         Raises :class:`ConfigError` naming the first bad key."""
         if "contacts" not in flat:
@@ -421,13 +435,13 @@ class SceneConfig:
         return cls(contacts=contacts, node=_build_node(node))
 
     @classmethod
-    def from_dict(cls, mapping: Mapping[str, Any]) -> "SceneConfig":
+    def from_dict(cls, mapping: Mapping[str, Any]) -> SceneConfig:
         """From a ROS params mapping ``{node: {"ros__parameters": {...}}}``, the bare
         ``ros__parameters`` mapping, or the flat dotted form."""
         return cls.from_parameters(_unwrap(mapping))
 
     @classmethod
-    def from_yaml(cls, path: str | Path) -> "SceneConfig":
+    def from_yaml(cls, path: str | Path) -> SceneConfig:
         """From a ROS 2 parameters YAML file (or a bare/flat mapping in YAML)."""
         file = Path(path)
         try:
@@ -457,7 +471,9 @@ class SceneConfig:
                 flat[f"{prefix}material.{name}"] = _plain(getattr(material, name))
             for section in ("adhesion", "numerics"):
                 for item in fields(_SECTIONS[section]):
-                    flat[f"{prefix}{section}.{item.name}"] = _plain(getattr(getattr(contact, section), item.name))
+                    flat[f"{prefix}{section}.{item.name}"] = _plain(
+                        getattr(getattr(contact, section), item.name)
+                    )
         for key in NODE_KEYS:
             flat[key] = getattr(self.node, key.replace(".", "_"))
         return flat

@@ -8,6 +8,8 @@ user can find it in the scene file without reading a traceback.
 
 from __future__ import annotations
 
+import numpy
+
 
 class ConfigError(ValueError):
     """A scene configuration is malformed: unknown key, wrong type, out-of-range value."""
@@ -38,11 +40,9 @@ def require_positive(name: str, value: float) -> float:
     return number
 
 
-def require_positive_array(name: str, values: object) -> "numpy.ndarray":
+def require_positive_array(name: str, values: object) -> numpy.ndarray:
     """Return ``values`` as a 1-D float64 array of finite numbers > 0; the error names the
     first bad element as ``name[i]``."""
-    import numpy
-
     try:
         array = numpy.asarray(values, dtype=numpy.float64).reshape(-1)
     except (TypeError, ValueError):

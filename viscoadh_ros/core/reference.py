@@ -15,7 +15,11 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.special import dawsn
 
-from viscoadh_ros.core.criterion import critical_glass_elongation, work_of_adhesion_detaching, work_of_adhesion_indenting
+from viscoadh_ros.core.criterion import (
+    critical_glass_elongation,
+    work_of_adhesion_detaching,
+    work_of_adhesion_indenting,
+)
 from viscoadh_ros.core.errors import InputError, require_finite, require_positive
 from viscoadh_ros.core.profiles import Profile
 from viscoadh_ros.core.rheology import CreepElement
@@ -51,7 +55,12 @@ def hertz_radius(depth: ArrayLike, radius: float) -> FloatArray:
 def hertz_force(depth: ArrayLike, radius: float, modulus_star: float) -> FloatArray:
     """Hertz force ``F = (4/3) E* sqrt(R) d^(3/2)``, N (0 for ``d <= 0``)."""
     d = np.maximum(_array("depth", depth), 0.0)
-    return (4.0 / 3.0) * require_positive("modulus_star", modulus_star) * math.sqrt(require_positive("radius", radius)) * d**1.5
+    return (
+        (4.0 / 3.0)
+        * require_positive("modulus_star", modulus_star)
+        * math.sqrt(require_positive("radius", radius))
+        * d**1.5
+    )
 
 
 def _cone_slope(half_angle: float) -> float:
@@ -75,7 +84,9 @@ def sneddon_cone_force(depth: ArrayLike, half_angle: float, modulus_star: float)
 
 def flat_punch_stiffness(punch_radius: float, modulus_star: float) -> float:
     """Normal stiffness of a flat punch in full contact, ``k = 2 E* a0``, N/m."""
-    return 2.0 * require_positive("modulus_star", modulus_star) * require_positive("punch_radius", punch_radius)
+    return (
+        2.0 * require_positive("modulus_star", modulus_star) * require_positive("punch_radius", punch_radius)
+    )
 
 
 def flat_punch_force(depth: ArrayLike, punch_radius: float, modulus_star: float) -> FloatArray:
@@ -86,14 +97,18 @@ def flat_punch_force(depth: ArrayLike, punch_radius: float, modulus_star: float)
 # --- elastic adhesion (JKR, Kendall, general MDR) ----------------------------------------
 
 
-def jkr_depth(contact_radius: ArrayLike, radius: float, modulus_star: float, work_of_adhesion: float) -> FloatArray:
+def jkr_depth(
+    contact_radius: ArrayLike, radius: float, modulus_star: float, work_of_adhesion: float
+) -> FloatArray:
     """JKR depth at contact radius ``a``: ``d = a^2/R - sqrt(2 pi a w / E*)``, m."""
     a = _array("contact_radius", contact_radius, nonnegative=True)
     r = require_positive("radius", radius)
     return a**2 / r - critical_glass_elongation(a, _work(work_of_adhesion), modulus_star)
 
 
-def jkr_force(contact_radius: ArrayLike, radius: float, modulus_star: float, work_of_adhesion: float) -> FloatArray:
+def jkr_force(
+    contact_radius: ArrayLike, radius: float, modulus_star: float, work_of_adhesion: float
+) -> FloatArray:
     """JKR force at contact radius ``a``: ``F = 4 E* a^3/(3R) - sqrt(8 pi w E* a^3)``, N."""
     a = _array("contact_radius", contact_radius, nonnegative=True)
     e = require_positive("modulus_star", modulus_star)
@@ -127,7 +142,9 @@ def jkr_pull_off_force_control(radius: float, modulus_star: float, work_of_adhes
     return _jkr_point(9.0 * math.pi * w * r**2 / (8.0 * e), r, e, w)
 
 
-def jkr_pull_off_displacement_control(radius: float, modulus_star: float, work_of_adhesion: float) -> ContactPoint:
+def jkr_pull_off_displacement_control(
+    radius: float, modulus_star: float, work_of_adhesion: float
+) -> ContactPoint:
     """Last stable JKR point under displacement control: ``F = -(5/6) pi R w`` at
     ``a^3 = pi w R^2/(8 E*)`` (the minimum of the parametric depth ``d(a)``)."""
     w = _work(work_of_adhesion)
@@ -138,7 +155,9 @@ def jkr_pull_off_displacement_control(radius: float, modulus_star: float, work_o
 def kendall_pull_off(punch_radius: float, modulus_star: float, work_of_adhesion: float) -> float:
     """Kendall pull-off force of a flat punch, ``F = -sqrt(8 pi E* a0^3 w)``, N."""
     a0 = require_positive("punch_radius", punch_radius)
-    return -math.sqrt(8.0 * math.pi * require_positive("modulus_star", modulus_star) * a0**3 * _work(work_of_adhesion))
+    return -math.sqrt(
+        8.0 * math.pi * require_positive("modulus_star", modulus_star) * a0**3 * _work(work_of_adhesion)
+    )
 
 
 def mdr_adhesive_curve(
@@ -177,7 +196,9 @@ def _ramp_kernel(y: FloatArray) -> FloatArray:
     return np.where(y < 0.5, series, y - dawsn(y))
 
 
-def lee_radok_ramp_force(time: ArrayLike, velocity: float, radius: float, element: CreepElement) -> FloatArray:
+def lee_radok_ramp_force(
+    time: ArrayLike, velocity: float, radius: float, element: CreepElement
+) -> FloatArray:
     """Lee-Radok force of a rigid sphere pressed at constant speed ``d = v t`` into a
     non-adhesive viscoelastic half-space, N, at times ``t >= 0`` (s).
 
@@ -194,7 +215,7 @@ def lee_radok_ramp_force(time: ArrayLike, velocity: float, radius: float, elemen
     r = require_positive("radius", radius)
     prony = element.prony
     total = prony.long_term_modulus * (r * v * t) ** 1.5
-    for modulus, tau in zip(prony.moduli, prony.times):
+    for modulus, tau in zip(prony.moduli, prony.times, strict=True):
         total = total + 1.5 * modulus * (r * v * tau) ** 1.5 * _ramp_kernel(np.sqrt(t / tau))
     return 8.0 / (3.0 * (1.0 - element.poisson_ratio) * r) * total
 

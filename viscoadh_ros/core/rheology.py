@@ -97,7 +97,7 @@ class CreepElement:
         object.__setattr__(self, "poisson_ratio", nu)
 
     @classmethod
-    def from_config(cls, material: Any) -> "CreepElement":
+    def from_config(cls, material: Any) -> CreepElement:
         """From a ``MaterialConfig`` (whose Prony keys, if any, the loader already converted)."""
         return cls(
             glass_shear_modulus=material.glass_shear_modulus,
@@ -179,9 +179,9 @@ def _secular_roots(constant: float, weights: FloatArray, poles: FloatArray) -> F
         upper = 2.0 * poles[-1]
         while h(upper) <= 0.0:
             upper *= 2.0
-        brackets = list(zip(poles, np.append(poles[1:], upper)))
+        brackets = list(zip(poles, np.append(poles[1:], upper), strict=True))
     else:
-        brackets = list(zip(np.insert(poles[:-1], 0, 0.0), poles))
+        brackets = list(zip(np.insert(poles[:-1], 0, 0.0), poles, strict=True))
     roots = []
     for low, high in brackets:
         # Step off the poles (where h is infinite) just far enough for h to change sign.
@@ -202,7 +202,9 @@ def _secular_roots(constant: float, weights: FloatArray, poles: FloatArray) -> F
     return np.array(roots)
 
 
-def _merge_equal_times(moduli: FloatArray, times: FloatArray, compliant: bool) -> tuple[FloatArray, FloatArray]:
+def _merge_equal_times(
+    moduli: FloatArray, times: FloatArray, compliant: bool
+) -> tuple[FloatArray, FloatArray]:
     """Merge terms with identical times so the root brackets are not empty. Kelvin elements
     with one retardation time act as one (compliances add: ``compliant``); Prony terms with
     one relaxation time add their moduli."""
@@ -270,7 +272,11 @@ def prony_to_creep(
 
 
 def standard_solid(
-    *, glass_shear_modulus: float, relaxed_shear_modulus: float, relaxation_time: float, poisson_ratio: float = 0.5
+    *,
+    glass_shear_modulus: float,
+    relaxed_shear_modulus: float,
+    relaxation_time: float,
+    poisson_ratio: float = 0.5,
 ) -> CreepElement:
     """Standard solid (K = 1) from ``G0``, ``G_inf`` (Pa, ``0 < G_inf < G0``) and the relaxation
     time ``tau`` (s): ``G1 = G0 G_inf / (G0 - G_inf)``, ``eta1 = tau (G0 + G1)``."""
@@ -286,5 +292,3 @@ def standard_solid(
         kelvin_viscosities=np.array([tau * (g0 + g1)]),
         poisson_ratio=poisson_ratio,
     )
-
-
