@@ -1,0 +1,446 @@
+"""The ``viscoadh`` node: a thin ROS 2 adapter over the contact simulator.
+
+Per contact id ``C`` of the scene: subscribes ``C/indentation``, publishes ``C/state``,
+``C/wrench`` (and ``C/marker`` when ``markers.enabled``), serves ``C/simulate_history``,
+``C/predict_pull_off`` and ``C/reset``; node-wide it publishes ``/diagnostics`` at 1 Hz.
+The full interface with units and sign conventions is in docs/ros_interface.md.
+
+Threading: each contact's live path (command subscription and hold timer) is in its own
+mutually exclusive callback group, the services of all contacts in one reentrant group, and
+``main`` spins a MultiThreadedExecutor, so a long ``simulate_history`` never queues a command.
+A per-contact lock guards the simulator against the services and parameter changes, which run
+on other executor threads.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import sys
+import threading
+import time
+from typing import Any, Protocol
+
+import rclpy
+from diagnostic_msgs.msg import DiagnosticArray
+from geometry_msgs.msg import WrenchStamped
+from rcl_interfaces.msg import SetParametersResult
+from rclpy.callback_groups import MutuallyExclusiveCallbackGroup, ReentrantCallbackGroup
+from rclpy.clock import JumpThreshold, TimeJump
+from rclpy.duration import Duration
+from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+from std_srvs.srv import Trigger
+from viscoadh_msgs.msg import ContactState, IndentationCommand
+from viscoadh_msgs.srv import PredictPullOff, SimulateHistory
+from visualization_msgs.msg import Marker
+
+from viscoadh_ros.core._kernels import warm_up
+from viscoadh_ros.core.config import ContactConfig, SceneConfig
+from viscoadh_ros.core.errors import ConfigError, InputError
+from viscoadh_ros.core.history import predict_pull_off, simulate_history
+from viscoadh_ros.core.simulator import ContactSimulator, StepOutput
+from viscoadh_ros.ros import conversions, diagnostics, markers, parameters
+
+NODE_NAME = "viscoadh"
+#: An idle contact (out of touch, relaxed) republishes its unchanging state at this period.
+IDLE_PUBLISH_PERIOD_NS = 1_000_000_000
+#: Period of /diagnostics.
+DIAGNOSTICS_PERIOD_S = 1.0
+#: Minimum interval between two warnings of the same kind of rejection (throttled log), s.
+WARN_THROTTLE_S = 1.0
+_QOS_DEPTH = 10
+
+
+class Recorder(Protocol):
+    """What the node hands every message it receives and publishes to (MCAP logging)."""
+
+    def record(self, topic: str, msg: Any, stamp_ns: int) -> bool:
+        """Queue ``msg`` seen on ``topic`` at log time ``stamp_ns`` (node clock); never blocks.
+        False when the message was dropped (full queue)."""
+
+    def close(self) -> None:
+        """Finish the log."""
+
+
+class _Contact:
+    """The live state and ROS endpoints of one contact id."""
+
+    def __init__(self, node: ViscoadhNode, config: ContactConfig) -> None:
+        self.node = node
+        self.id = config.id
+        self.config = config
+        self.simulator = ContactSimulator(config)
+        self.lock = threading.Lock()
+        self.counters = diagnostics.ContactCounters()
+        # Simulation time is node-clock time minus an epoch (integer ns) set by the first event
+        # after start or reset, so float seconds keep sub-microsecond resolution.
+        self.epoch_ns: int | None = None
+        self.last_command_ns: int | None = None
+        self.last_clock_ns: int | None = None
+        self.last_publish_ns: int | None = None
+        # The last accepted control ({"depth": d} or {"force": f}); the hold timer keeps it, so
+        # a contact under force control creeps at constant force between commands.
+        self.hold: dict[str, float] = {}
+
+        live = MutuallyExclusiveCallbackGroup()
+        self.state_pub = node.create_publisher(ContactState, f"{self.id}/state", _QOS_DEPTH)
+        self.wrench_pub = node.create_publisher(WrenchStamped, f"{self.id}/wrench", _QOS_DEPTH)
+        self.marker_pub = node.create_publisher(Marker, f"{self.id}/marker", _QOS_DEPTH)
+        self.subscription = node.create_subscription(
+            IndentationCommand,
+            f"{self.id}/indentation",
+            self.on_command,
+            _QOS_DEPTH,
+            callback_group=live,
+        )
+        self.timer = node.create_timer(1.0 / node.scene.node.publish_rate, self.on_timer, callback_group=live)
+        services = node.services_group
+        node.create_service(
+            SimulateHistory,
+            f"{self.id}/simulate_history",
+            self.on_simulate_history,
+            callback_group=services,
+        )
+        node.create_service(
+            PredictPullOff,
+            f"{self.id}/predict_pull_off",
+            self.on_predict_pull_off,
+            callback_group=services,
+        )
+        node.create_service(Trigger, f"{self.id}/reset", self.on_reset, callback_group=services)
+
+    # --- clock -------------------------------------------------------------------------------
+
+    def _sim_time(self, ns: int) -> float:
+        """Simulation time, s, of node-clock time ``ns`` (sets the epoch on first use)."""
+        if self.epoch_ns is None:
+            self.epoch_ns = ns
+        return (ns - self.epoch_ns) * 1e-9
+
+    def _reset_locked(self) -> None:
+        self.simulator.reset(time=0.0)
+        self.epoch_ns = None
+        self.last_command_ns = None
+        self.last_publish_ns = None
+        self.hold = {}
+
+    def _check_clock_locked(self, now_ns: int) -> None:
+        """Reset the contact when the node clock went backwards (a looping bag, a clock reset).
+
+        ROS time jumps are also caught by the node's jump handler (a timer on ROS time does not
+        fire after a backward jump); this check covers a system clock set back.
+        """
+        if self.last_clock_ns is not None and now_ns < self.last_clock_ns:
+            self.clock_jumped_locked((self.last_clock_ns - now_ns) * 1e-9)
+        self.last_clock_ns = now_ns
+
+    def clock_jumped_locked(self, back_s: float) -> None:
+        """Reset after the clock went back by ``back_s`` seconds, with a warning."""
+        self.node.get_logger().warning(f"{self.id}: clock jumped back by {back_s:.3f} s; contact reset")
+        self._reset_locked()
+        self.last_clock_ns = None
+
+    # --- live path ---------------------------------------------------------------------------
+
+    def on_command(self, msg: IndentationCommand) -> None:
+        """Step to the command's stamp and publish the state at that stamp, or reject."""
+        now_ns = self.node.now_ns()
+        self.node.record(self.subscription.topic_name, msg, now_ns)
+        stamp_ns = conversions.stamp_to_ns(msg.header.stamp) or now_ns
+        with self.lock:
+            self._check_clock_locked(now_ns)
+            try:
+                control = conversions.command_control(msg)
+                if self.last_command_ns is not None and stamp_ns < self.last_command_ns:
+                    raise InputError(
+                        f"header.stamp {stamp_ns * 1e-9:.9f} s is older than the last "
+                        f"command's {self.last_command_ns * 1e-9:.9f} s"
+                    )
+                if self.last_command_ns is None:
+                    # First command since start or reset: the contact was at rest and nothing
+                    # says where the indenter was, so its history starts at this stamp (the
+                    # way simulate_history starts at its first sample).
+                    self.simulator.reset(time=0.0)
+                    self.epoch_ns = stamp_ns
+                # A hold tick may have advanced the contact past a command that was stamped
+                # (just) before it: apply it now rather than go back in time.
+                target = max(self._sim_time(stamp_ns), self.simulator.time)
+                started = time.perf_counter()
+                output = self.simulator.step(target, **control)
+                self.counters.steps.add(time.perf_counter() - started)
+            except ValueError as error:
+                self._reject_locked(f"command rejected: {error}", command=True)
+                return
+            self.counters.commands_received += 1
+            self.hold = control
+            self.last_command_ns = stamp_ns
+            self.last_publish_ns = now_ns
+            state = self._state_locked(output, stamp_ns)
+        self._publish(state, output, stamp_ns, now_ns)
+
+    def on_timer(self) -> None:
+        """Between commands: advance the contact to now (hold, relaxation) and publish."""
+        now_ns = self.node.now_ns()
+        with self.lock:
+            self._check_clock_locked(now_ns)
+            if self.last_publish_ns is not None:
+                since = now_ns - self.last_publish_ns
+                # Commands arriving at least as fast as the timer already publish every state.
+                if since < self.timer.timer_period_ns // 2:
+                    return
+                if self.simulator.is_idle and since < IDLE_PUBLISH_PERIOD_NS:
+                    return
+            target = self._sim_time(now_ns)
+            if target > self.simulator.time:
+                started = time.perf_counter()
+                # An accepted control held to a later time is valid input by construction.
+                if self.hold:
+                    output = self.simulator.step(target, **self.hold)
+                else:
+                    output = self.simulator.advance(target)
+                self.counters.steps.add(time.perf_counter() - started)
+            else:
+                output = self.simulator.output
+            self.last_publish_ns = now_ns
+            state = self._state_locked(output, now_ns)
+        self._publish(state, output, now_ns, now_ns)
+        if self.node.markers_enabled:
+            for marker in markers.contact_markers(
+                output,
+                self.config.indenter,
+                contact_id=self.id,
+                stamp_ns=now_ns,
+                frame_id=self.node.frame_id,
+            ):
+                self.marker_pub.publish(marker)
+
+    def _state_locked(self, output: StepOutput, stamp_ns: int) -> ContactState:
+        return conversions.contact_state(
+            output,
+            stamp_ns=stamp_ns,
+            frame_id=self.node.frame_id,
+            model=self.simulator.model,
+            commands_received=self.counters.commands_received,
+            commands_rejected=self.counters.commands_rejected,
+        )
+
+    def _publish(self, state: ContactState, output: StepOutput, stamp_ns: int, now_ns: int) -> None:
+        wrench = conversions.wrench(output, stamp_ns=stamp_ns, frame_id=state.header.frame_id)
+        self.state_pub.publish(state)
+        self.wrench_pub.publish(wrench)
+        self.node.record(self.state_pub.topic_name, state, now_ns)
+        self.node.record(self.wrench_pub.topic_name, wrench, now_ns)
+
+    def _reject_locked(self, reason: str, *, command: bool) -> None:
+        self.counters.reject(reason, command=command)
+        self.node.get_logger().warning(f"{self.id}: {reason}", throttle_duration_sec=WARN_THROTTLE_S)
+
+    # --- services ----------------------------------------------------------------------------
+
+    def on_simulate_history(
+        self, request: SimulateHistory.Request, response: SimulateHistory.Response
+    ) -> SimulateHistory.Response:
+        """Run a whole history from a fresh state of this contact; the live state is untouched."""
+        config = self.config
+        try:
+            result = simulate_history(config, **conversions.history_request(request))
+        except ValueError as error:
+            return self._fail(response, f"simulate_history rejected: {error}")
+        return conversions.history_response(result, response)
+
+    def on_predict_pull_off(
+        self, request: PredictPullOff.Request, response: PredictPullOff.Response
+    ) -> PredictPullOff.Response:
+        """Pull-off if the indenter retracted now at ``retract_speed``, from a copy of the live
+        state held to now."""
+        now_ns = self.node.now_ns()
+        with self.lock:
+            snapshot = self.simulator.snapshot()
+            config = self.config
+            now_s = self._sim_time(now_ns)
+        try:
+            copy = ContactSimulator(config)
+            copy.restore(snapshot)
+            if now_s > copy.time:
+                copy.advance(now_s)
+            prediction = predict_pull_off(copy, request.retract_speed)
+        except ValueError as error:
+            return self._fail(response, f"predict_pull_off rejected: {error}")
+        response.pull_off_force = float(prediction.pull_off_force)
+        response.pull_off_depth = float(prediction.pull_off_depth)
+        response.time_to_detach = float(prediction.time_to_detach)
+        response.success = True
+        response.message = f"retracting at {request.retract_speed:g} m/s"
+        return response
+
+    def on_reset(self, request: Trigger.Request, response: Trigger.Response) -> Trigger.Response:
+        """Forget the contact's history: fresh, relaxed, out of touch."""
+        with self.lock:
+            self._reset_locked()
+        response.success = True
+        response.message = f"contact '{self.id}' reset"
+        return response
+
+    def _fail(self, response: Any, reason: str) -> Any:
+        with self.lock:
+            self._reject_locked(reason, command=False)
+        response.success = False
+        response.message = reason
+        return response
+
+    # --- reconfiguration and diagnostics -----------------------------------------------------
+
+    def replace_config_locked(self, config: ContactConfig) -> None:
+        """Use ``config`` from now on (caller holds the lock and checked the contact is idle)."""
+        self.config = config
+        self.simulator = ContactSimulator(config)
+        self.epoch_ns = None
+        self.last_command_ns = None
+
+    def set_publish_rate(self, rate: float) -> None:
+        """Run the hold timer at ``rate`` Hz from now on."""
+        self.timer.timer_period_ns = int(1e9 / rate)
+
+    def status(self) -> Any:
+        with self.lock:
+            output = self.simulator.output
+            return diagnostics.contact_status(
+                self.id,
+                self.counters,
+                model=self.simulator.model,
+                scale_separation_ok=bool(output.scale_separation_ok),
+                in_contact=self.simulator.in_contact,
+            )
+
+
+class ViscoadhNode(Node):
+    """The ``viscoadh`` node. Keyword arguments go to :class:`rclpy.node.Node` (``context``,
+    ``parameter_overrides``, ``namespace``, ...).
+
+    Raises ConfigError (naming the key) when the scene in the parameters is invalid.
+    """
+
+    def __init__(self, **kwargs: Any) -> None:
+        started = time.perf_counter()
+        super().__init__(NODE_NAME, automatically_declare_parameters_from_overrides=True, **kwargs)
+        self.scene: SceneConfig = parameters.scene_from_node(self)
+        parameters.declare_scene(self, self.scene)
+        self.frame_id = self.scene.node.frame_id
+        self.markers_enabled = self.scene.node.markers_enabled
+        # MCAP logging (issue 5) plugs in here; None while logging is off.
+        self._recorder: Recorder | None = None
+        # Compile/load every numba kernel before the first command can arrive (~0.2 s).
+        warm_up()
+        warmed = time.perf_counter()
+        self.services_group = ReentrantCallbackGroup()
+        self.contacts = {c.id: _Contact(self, c) for c in self.scene.contacts}
+        self._jump_handler = self.get_clock().create_jump_callback(
+            JumpThreshold(min_forward=None, min_backward=Duration(nanoseconds=-1)),
+            post_callback=self._on_clock_jump,
+        )
+        self._parameter_lock = threading.Lock()
+        self.add_on_set_parameters_callback(self._on_set_parameters)
+        self.diagnostics_pub = self.create_publisher(DiagnosticArray, "/diagnostics", _QOS_DEPTH)
+        self.create_timer(DIAGNOSTICS_PERIOD_S, self._publish_diagnostics)
+        self.get_logger().info(
+            f"ready in {time.perf_counter() - started:.3f} s (numba warm-up "
+            f"{warmed - started:.3f} s); contacts: "
+            + ", ".join(f"{c.id} [{c.simulator.model}]" for c in self.contacts.values())
+        )
+
+    def now_ns(self) -> int:
+        """Node clock (ROS time under ``use_sim_time``), ns."""
+        return self.get_clock().now().nanoseconds
+
+    def _on_clock_jump(self, jump: TimeJump) -> None:
+        """ROS time went back (``/clock`` of a looping bag): reset every contact."""
+        for contact in self.contacts.values():
+            with contact.lock:
+                contact.clock_jumped_locked(-jump.delta.nanoseconds * 1e-9)
+
+    def record(self, topic: str, msg: Any, stamp_ns: int) -> None:
+        """Hand a received or published message to the recorder, if logging is on."""
+        if self._recorder is not None:
+            self._recorder.record(topic, msg, stamp_ns)
+
+    def _publish_diagnostics(self) -> None:
+        statuses = [contact.status() for contact in self.contacts.values()]
+        self.diagnostics_pub.publish(diagnostics.diagnostic_array(statuses, stamp_ns=self.now_ns()))
+
+    def _on_set_parameters(self, changed: list[Parameter]) -> SetParametersResult:
+        """Validate a runtime change through the scene schema and apply it, or refuse it.
+
+        Node-level ``publish_rate``, ``frame_id`` and ``markers.enabled`` apply at once. A
+        contact's physics can change only while that contact is out of touch and relaxed
+        (``is_idle``): its simulator is replaced, which would otherwise discard a live state.
+        """
+        ids = tuple(self.contacts)
+        flat = self.scene.to_parameters()
+        touched: set[str] = set()
+        for parameter in changed:
+            owner = parameters.classify_change(parameter.name, ids)
+            if owner is None:
+                return _refuse(f"{parameter.name} is not a scene parameter")
+            if owner == "" and parameter.name not in parameters.RUNTIME_NODE_PARAMETERS:
+                return _refuse(f"{parameter.name} cannot change while the node runs")
+            if owner:
+                touched.add(owner)
+            flat[parameter.name] = parameter.value
+        try:
+            scene = SceneConfig.from_parameters(flat)
+        except ConfigError as error:
+            return _refuse(str(error))
+        with self._parameter_lock, contextlib.ExitStack() as stack:
+            for contact_id in sorted(touched):
+                stack.enter_context(self.contacts[contact_id].lock)
+            for contact_id in sorted(touched):
+                if not self.contacts[contact_id].simulator.is_idle:
+                    return _refuse(
+                        f"contact '{contact_id}' is in contact or still relaxing; change its "
+                        "parameters when it is out of touch and relaxed (or after "
+                        f"{contact_id}/reset)"
+                    )
+            for contact_id in touched:
+                self.contacts[contact_id].replace_config_locked(scene.contact(contact_id))
+        if scene.node.publish_rate != self.scene.node.publish_rate:
+            for contact in self.contacts.values():
+                contact.set_publish_rate(scene.node.publish_rate)
+        self.frame_id = scene.node.frame_id
+        self.markers_enabled = scene.node.markers_enabled
+        self.scene = scene
+        return SetParametersResult(successful=True)
+
+    def destroy_node(self) -> None:
+        if self._recorder is not None:
+            self._recorder.close()
+            self._recorder = None
+        super().destroy_node()
+
+
+def _refuse(reason: str) -> SetParametersResult:
+    return SetParametersResult(successful=False, reason=reason)
+
+
+def main(args: list[str] | None = None) -> int:
+    """Run the node until Ctrl-C or shutdown (console script ``viscoadh_node``).
+
+    Returns 0, or 2 with one error line when the scene in the parameters is invalid.
+    """
+    rclpy.init(args=args)
+    node = None
+    try:
+        node = ViscoadhNode()
+        executor = MultiThreadedExecutor()
+        executor.add_node(node)
+        executor.spin()
+    except ConfigError as error:
+        print(f"viscoadh node: error: {error}", file=sys.stderr, flush=True)
+        return 2
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        if node is not None:
+            node.destroy_node()
+        rclpy.try_shutdown()
+    return 0
