@@ -34,8 +34,8 @@ Outputs (`StepOutput`), beyond depth, force and radius:
 - ``scale_separation_ok``: the energy criterion assumes the edge moves fast compared
   with relaxation over the interaction range h (paper, section 5). With
   ``v_c1 = pi G0 h^2 / (tau w)`` (tau = the shortest relaxation time, the strict side)
-  and ``v_c2 = v_c1 (E_r*/E0*)^2``: an advancing edge needs ``|edge_speed| >= v_c1``, a
-  receding one ``|edge_speed| >= v_c2``. A pinned edge, no contact, an elastic material
+  and ``v_c2 = v_c1 (G_inf/G0)^2`` (`criterion.critical_edge_speeds`): an advancing edge
+  needs ``|edge_speed| >= v_c1``, a receding one ``|edge_speed| >= v_c2``. A pinned edge, no contact, an elastic material
   or ``w = 0`` are always ok.
 """
 
@@ -50,7 +50,7 @@ import numpy as np
 from scipy.optimize import brentq
 
 from . import _kernels
-from .criterion import critical_glass_elongation
+from .criterion import critical_edge_speeds, critical_glass_elongation, scale_separation_holds
 from .errors import ConfigError, InputError, require_finite
 from .presets import ResolvedNumerics, resolve_numerics
 from .profiles import Profile, make_profile
@@ -104,14 +104,7 @@ class _Physics:
         self.e_relaxed = self.creep.relaxed_modulus_star
         # dl_c(x) = c_crit * sqrt(x)
         self.c_crit = float(critical_glass_elongation(1.0, self.work_of_adhesion, self.e0))
-        if self.creep.kelvin_count and self.work_of_adhesion > 0.0:
-            tau = float(np.min(self.creep.relaxation_times))
-            self.v_attach = (
-                math.pi * self.creep.glass_shear_modulus * self.interaction_range**2 / (tau * self.work_of_adhesion)
-            )
-            self.v_detach = self.v_attach * (self.e_relaxed / self.e0) ** 2
-        else:
-            self.v_attach = self.v_detach = 0.0
+        self.critical_speeds = critical_edge_speeds(self.creep, self.work_of_adhesion, self.interaction_range)
 
     def edge_elongation(self, depth: float, radius: float) -> float:
         """Total elongation u(a) = d - g(a) of the edge element, m."""
@@ -124,11 +117,7 @@ class _Physics:
         return self.e_relaxed * u * u / (2.0 * math.pi * radius) if u < 0.0 else 0.0
 
     def scale_separation_ok(self, edge_speed: float) -> bool:
-        if edge_speed > 0.0:
-            return edge_speed >= self.v_attach
-        if edge_speed < 0.0:
-            return -edge_speed >= self.v_detach
-        return True
+        return bool(scale_separation_holds(edge_speed, self.critical_speeds))
 
     def adhesion_length(self) -> float:
         """Contact radius of the relaxed JKR contact at zero depth with the detachment-side
@@ -284,6 +273,8 @@ class _TimeStepped:
         # Dampers scale like springs: eta* = 2 eta / (1 - nu).
         eta_kelvin = np.array([creep.modulus_star(v) for v in creep.kelvin_viscosities], dtype=np.float64)
         self.e_kelvin = e_kelvin
+        # Steady in-contact share of each Kelvin element in the total elongation.
+        self.steady = physics.e_relaxed / e_kelvin if e_kelvin.size else np.zeros(0)
         self.rate = e_kelvin / eta_kelvin if e_kelvin.size else np.zeros(0)
         self.p, self.p_inv, self.lam, self.beta = _modal_chain(physics.e0, e_kelvin, eta_kelvin)
         self.punch_radius = getattr(physics.profile, "punch_radius", None)
@@ -320,7 +311,7 @@ class _TimeStepped:
             gf=np.asarray(profile.g(fine), dtype=np.float64),
             gint=np.asarray(profile.g_integral(fine), dtype=np.float64), df=fine[1], reach=reach,
             wl=wl, p=self.p, p_inv=self.p_inv, lam=self.lam, beta=self.beta, rate=self.rate,
-            e_kelvin=self.e_kelvin,
+            e_kelvin=self.e_kelvin, steady=self.steady, e0=self.physics.e0, c_crit=self.physics.c_crit,
         )
 
     def _grow(self) -> None:
@@ -361,8 +352,7 @@ class _TimeStepped:
         while True:
             row = self.row
             status, out = _kernels.advance(
-                row, self.radius, d0, d1, dt, e0=self.physics.e0, c_crit=self.physics.c_crit,
-                max_substep=self.numerics.max_substep, max_edge_move=self.numerics.max_edge_cells * row.dx,
+                row, self.radius, d0, d1, dt, max_substep=self.numerics.max_substep, max_edge_move=self.numerics.max_edge_cells * row.dx,
             )
             if status == _kernels.STATUS_OK:
                 break
@@ -379,15 +369,14 @@ class _TimeStepped:
     def stored_energy(self, depth: float) -> float:
         if self.row is None:
             return 0.0
-        return _kernels.stored_energy(self.row, self.radius, depth, self.physics.e0)
+        return _kernels.stored_energy(self.row, self.radius, depth)
 
     def edge_gaps(self, depth: float) -> tuple[float, float]:
         """h at the edge with the exterior and with the interior memory, m."""
         assert self.row is not None
-        c = self.physics.c_crit
         return (
-            _kernels.criterion_gap(self.row, self.radius, depth, c, False, self.radius),
-            _kernels.criterion_gap(self.row, self.radius, depth, c, True, self.radius),
+            _kernels.criterion_gap(self.row, self.radius, depth, self.radius, interior=False),
+            _kernels.criterion_gap(self.row, self.radius, depth, self.radius, interior=True),
         )
 
     def is_relaxed(self) -> bool:
