@@ -382,8 +382,8 @@ def _advance(wl, wsum, scratch, a, d0, d1, dt, dx, g_c, gf, gint, df, e0, c_crit
     """Advance the row from depth d0 to d1 (linear in time) over dt with adaptive substeps.
 
     Substeps are halved while the edge would move more than ``max_edge_move`` (m) in one
-    of them, except for jumps from or to no contact (snap-in, pull-off), which no step
-    size resolves. Writes radius, force, work input, last motion and substep count to
+    of them, down to ``1e-7 dt``: a true jump (snap-in, the fold at pull-off) is thereby
+    located in time and crossed in one tiny substep that does no work. Writes radius, force, work input, last motion and substep count to
     ``out``. Returns STATUS_GROW (state partly advanced: the caller restores) when the
     contact needs a larger domain.
     """
@@ -421,7 +421,7 @@ def _advance(wl, wsum, scratch, a, d0, d1, dt, dx, g_c, gf, gint, df, e0, c_crit
         new_a, sub_motion, grow = _locate_edge(a, db, wsum, dx, g_c, gf, df, c_crit, reach, kap)
         if grow:
             return STATUS_GROW
-        if abs(new_a - a) > max_edge_move and a > 0.0 and new_a > 0.0 and h > h_min:
+        if abs(new_a - a) > max_edge_move and h > h_min:
             for i in range(n):
                 total = 0.0
                 for k in range(wl.shape[1]):
