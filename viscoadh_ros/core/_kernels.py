@@ -573,6 +573,18 @@ class Row:
         """Domain length L, m."""
         return self.dx * self.elements
 
+    def with_memory(self, wl: np.ndarray) -> "Row":
+        """A new row with the same geometry and chain (shared, never written) and its own
+        copy of the Kelvin state `wl` (N, K)."""
+        clone = object.__new__(Row)
+        clone.__dict__.update(self.__dict__)
+        clone.wl = np.empty_like(self.wl)
+        clone.wsum = np.empty_like(self.wsum)
+        clone.scratch = np.empty_like(self.scratch)
+        clone.out = np.zeros(OUT_SIZE)
+        clone.set_memory(wl)
+        return clone
+
     def set_memory(self, wl: np.ndarray) -> None:
         """Replace the Kelvin state (N, K) after validation."""
         _check("wl", wl, self.wl.shape)

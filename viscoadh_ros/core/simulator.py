@@ -398,9 +398,14 @@ class _TimeStepped:
     def set_state(self, state: tuple) -> None:
         radius, row, memory = state
         self.radius = radius
-        self.row = row
-        if row is not None:
+        if row is None:
+            self.row = None
+        elif row is self.row:
             row.set_memory(memory)
+        else:
+            # A snapshot of another simulator (or of a replaced domain): never share the
+            # mutable arrays of a row between simulators.
+            self.row = row.with_memory(memory)
 
     def reset(self) -> None:
         self.radius = 0.0
