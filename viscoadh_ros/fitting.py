@@ -8,6 +8,14 @@ The fit works on their logarithms (all are positive and span decades) with resid
 every sample with every free parameter. Uncertainties (one standard deviation) come from the
 Jacobian at the optimum: ``cov = s^2 (J^T J)^-1`` with the residual variance ``s^2``.
 
+The model force is not a smooth function of the parameters everywhere: an unstable jump
+(snap-in, pull-off under displacement control) moves from one sample to the next as the
+parameters change, and the MDR row's finite elements make the force step slightly as the
+contact edge crosses them. So (1) the measured samples next to a jump of the measured force
+are left out of the residuals, and (2) the Jacobian of the uncertainty is a central secant over
+:data:`SECANT_STEP` of each log-parameter, wide against the element steps, rather than the
+optimiser's local difference quotient, which a step can blow up (and the error bar shrink).
+
 A parameter the data cannot fix (no pull-off for the work of adhesion, no rate or hold
 variation for a viscosity, two parameters that only act together) makes the fit fail with a
 :class:`FitError` naming it, never a value with a meaningless error bar.
@@ -38,6 +46,14 @@ UNITS = {"G": "Pa", "eta": "Pa s", "work_of_adhesion": "J/m^2"}
 MAX_RELATIVE_UNCERTAINTY = 0.5
 #: Condition number of the column-scaled Jacobian beyond which parameters only act together.
 MAX_CONDITION = 1e6
+#: Half-width of the central secant of the uncertainty Jacobian, in log-parameter (2 %).
+SECANT_STEP = 0.02
+#: A change of the measured force between consecutive samples larger than this fraction of
+#: max|F| (and than 10 median changes) is a jump; JUMP_MARGIN samples either side are left out.
+JUMP_FRACTION = 0.1
+JUMP_MARGIN = 2
+#: A pull-off needs a tensile force beyond this many noise deviations, released within them.
+PULL_OFF_NOISE_BAND = 5.0
 
 
 class FitError(InputError):
@@ -53,8 +69,12 @@ def unit_of(name: str) -> str:
 
 def parameter_names(kelvin: int) -> list[str]:
     """All parameter names of a chain with ``kelvin`` Kelvin elements."""
-    return ["G0", *(f"G{k}" for k in range(1, kelvin + 1)), *(f"eta{k}" for k in range(1, kelvin + 1)),
-            "work_of_adhesion"]
+    return [
+        "G0",
+        *(f"G{k}" for k in range(1, kelvin + 1)),
+        *(f"eta{k}" for k in range(1, kelvin + 1)),
+        "work_of_adhesion",
+    ]
 
 
 def parse_free(text: str, kelvin: int) -> list[str]:
@@ -63,7 +83,9 @@ def parse_free(text: str, kelvin: int) -> list[str]:
     allowed = parameter_names(kelvin)
     for name in names:
         if not _NAME.match(name) or name not in allowed:
-            raise InputError(f"--free: unknown parameter {name!r} for {kelvin} Kelvin element(s); known: {allowed}")
+            raise InputError(
+                f"--free: unknown parameter {name!r} for {kelvin} Kelvin element(s); known: {allowed}"
+            )
     if len(set(names)) != len(names) or not names:
         raise InputError(f"--free must name each parameter once (got {text!r})")
     return names
@@ -82,11 +104,16 @@ def parameters_of(contact: ContactConfig) -> dict[str, float]:
 
 def with_parameters(contact: ContactConfig, values: dict[str, float], kelvin: int) -> ContactConfig:
     """``contact`` with the material and adhesion set from ``values`` (all names of the chain)."""
+    # The fitted chain replaces any Prony series the base scene was given as (to_dict writes
+    # the Prony fields of such a material, which would silently drop the fit).
     material = dataclasses.replace(
         contact.material,
         glass_shear_modulus=values["G0"],
         kelvin_shear_moduli=tuple(values[f"G{k}"] for k in range(1, kelvin + 1)),
         kelvin_viscosities=tuple(values[f"eta{k}"] for k in range(1, kelvin + 1)),
+        prony_long_term_modulus=0.0,
+        prony_moduli=(),
+        prony_times=(),
     )
     adhesion = dataclasses.replace(contact.adhesion, work_of_adhesion=values["work_of_adhesion"])
     return dataclasses.replace(contact, material=material, adhesion=adhesion)
@@ -117,19 +144,19 @@ class FitResult:
     values: dict[str, float]  # every parameter of the chain (free and held)
     uncertainty: dict[str, float]  # free parameters only
     free: tuple[str, ...]
-    rmse: float  # N
-    max_error: float  # N
-    samples: int
+    rmse: float  # N, over the fitted samples
+    max_error: float  # N, over the fitted samples
+    samples: int  # fitted samples (measured ones minus those next to a jump)
     contact: ContactConfig  # the base contact with the fitted values
 
 
 def _identify_checks(experiment: Experiment, free: Sequence[str]) -> None:
     if experiment.measured_force.size < len(free) + 2:
         raise FitError(f"{experiment.measured_force.size} force samples cannot fit {len(free)} parameters")
-    if "work_of_adhesion" in free and not np.any(experiment.measured_force < 0.0):
+    if "work_of_adhesion" in free and not has_pull_off(experiment.measured_force):
         raise FitError(
-            "work_of_adhesion cannot be identified: the measured force is never tensile (no "
-            "pull-off in the record); hold it (leave it out of --free) or record a retraction"
+            "work_of_adhesion cannot be identified: the record holds no pull-off (a tensile force "
+            "released back to zero); hold it (leave it out of --free) or record a retraction"
         )
     if np.any(experiment.input_mode != 0):
         raise FitError("fit needs depth-controlled inputs; the record holds FORCE-mode commands")
@@ -151,14 +178,15 @@ def fit(
     for name in free:
         if not values[name] > 0.0 or not math.isfinite(values[name]):
             raise InputError(f"start value of {name} must be finite and > 0 (got {values[name]})")
-    measured = experiment.measured_force
+    usable = smooth_samples(experiment.measured_force)
+    measured = experiment.measured_force[usable]
     scale = float(np.max(np.abs(measured)))
 
     def model(theta: NDArray[np.float64], names: Sequence[str]) -> NDArray[np.float64]:
         trial = dict(values)
         trial.update({n: float(math.exp(t)) for n, t in zip(names, theta)})
         try:
-            return run_model(with_parameters(contact, trial, kelvin), experiment).model_force
+            return run_model(with_parameters(contact, trial, kelvin), experiment).model_force[usable]
         except ValueError:
             # The optimiser stepped outside what the model accepts: a large residual steers it back.
             return np.full(measured.shape, 1e3 * scale)
@@ -167,15 +195,26 @@ def fit(
     compressive = measured > 0.0
     if stage1 and "work_of_adhesion" in free and np.count_nonzero(compressive) > len(stage1) + 1:
         x0 = np.log([values[n] for n in stage1])
-        first = least_squares(lambda th: (model(th, stage1)[compressive] - measured[compressive]) / scale,
-                              x0, diff_step=1e-4, x_scale=1.0)
+        first = least_squares(
+            lambda th: (model(th, stage1)[compressive] - measured[compressive]) / scale,
+            x0,
+            diff_step=1e-4,
+            x_scale=1.0,
+        )
         values.update({n: float(math.exp(t)) for n, t in zip(stage1, first.x)})
     x0 = np.log([values[n] for n in free])
     result = least_squares(lambda th: (model(th, free) - measured) / scale, x0, diff_step=1e-4, x_scale=1.0)
     if not result.success:
         raise FitError(f"the fit did not converge: {result.message}")
     values.update({n: float(math.exp(t)) for n, t in zip(free, result.x)})
-    sigma = _uncertainty(result.jac, result.fun, free)
+    secant = np.column_stack(
+        [
+            (model(result.x + SECANT_STEP * e, free) - model(result.x - SECANT_STEP * e, free))
+            / (2 * SECANT_STEP * scale)
+            for e in np.eye(len(free))
+        ]
+    )
+    sigma = _uncertainty(secant, result.fun, free)
     residual = result.fun * scale
     return FitResult(
         values=values,
@@ -188,12 +227,41 @@ def fit(
     )
 
 
-def _uncertainty(jac: NDArray[np.float64], fun: NDArray[np.float64], free: Sequence[str]) -> NDArray[np.float64]:
+def has_pull_off(force: NDArray[np.float64]) -> bool:
+    """True if ``force`` (N, > 0 compressive) becomes tensile beyond its noise and later
+    returns to zero within it: the contact was pulled off. Noise is estimated robustly from the
+    sample-to-sample changes (median absolute deviation)."""
+    if force.size < 3:
+        return False
+    change = np.diff(force)
+    noise = 1.4826 * float(np.median(np.abs(change - np.median(change)))) / math.sqrt(2.0)
+    band = PULL_OFF_NOISE_BAND * noise
+    lowest = int(np.argmin(force))
+    return bool(force[lowest] < -band and np.any(np.abs(force[lowest + 1 :]) <= band))
+
+
+def smooth_samples(force: NDArray[np.float64]) -> NDArray[np.bool_]:
+    """Mask of the samples of a measured force away from its jumps (see the module docstring)."""
+    keep = np.ones(force.size, dtype=bool)
+    if force.size < 3:
+        return keep
+    change = np.abs(np.diff(force))
+    threshold = max(JUMP_FRACTION * float(np.max(np.abs(force))), 10.0 * float(np.median(change)))
+    for jump in np.flatnonzero(change > threshold):
+        keep[max(jump - JUMP_MARGIN, 0) : jump + 1 + JUMP_MARGIN + 1] = False
+    return keep
+
+
+def _uncertainty(
+    jac: NDArray[np.float64], fun: NDArray[np.float64], free: Sequence[str]
+) -> NDArray[np.float64]:
     """Standard deviations of the log-parameters; FitError for unidentified ones."""
     norms = np.linalg.norm(jac, axis=0)
     dead = [n for n, c in zip(free, norms) if not c > 1e-12 * max(float(np.max(norms)), 1e-300)]
     if dead:
-        raise FitError(f"{', '.join(dead)} cannot be identified: the force does not depend on it in this record")
+        raise FitError(
+            f"{', '.join(dead)} cannot be identified: the force does not depend on it in this record"
+        )
     scaled = jac / norms
     _, singular, vt = np.linalg.svd(scaled, full_matrices=False)
     if singular[-1] <= 0 or singular[0] / singular[-1] > MAX_CONDITION:
