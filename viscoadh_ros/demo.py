@@ -224,17 +224,21 @@ class _Driver:
             raise RuntimeError("the viscoadh node's predict_pull_off service did not come up")
 
     def command(self, time: float, depth: float) -> ContactState:
-        """Move the clock to ``time`` (s), command ``depth`` (m) there, return the node's answer."""
+        """Command ``depth`` (m) at ``time`` (s), wait for the node's answer, then move the
+        simulated clock to ``time``; returns the answer."""
         stamp_ns = round(time * 1e9)
         self._clock_msg.clock = self._command.header.stamp = conversions.ns_to_stamp(stamp_ns)
         self._command.depth = float(depth)
         with self._answer:
             self._waiting_for, self._state = stamp_ns, None
-            self._clock_pub.publish(self._clock_msg)
             self._command_pub.publish(self._command)
             if not self._answer.wait_for(lambda: self._state is not None, self._timeout):
                 raise RuntimeError(f"the viscoadh node did not answer the command at t = {time:g} s")
-            return self._state
+        # The clock moves only once the command is applied: moved first, it would let the
+        # node's hold timer keep the old depth up to t, and the command then jump the depth
+        # at an instant (a glass-modulus force spike) instead of ramping it over the period.
+        self._clock_pub.publish(self._clock_msg)
+        return self._state
 
     def predict_pull_off(self, retract_speed: float) -> PullOffPrediction:
         """Call ``predict_pull_off`` (m/s); RuntimeError if it fails or times out."""
