@@ -1,0 +1,221 @@
+"""Numerical stability of the contact simulator at the extremes (hypothesis property tests).
+
+Covered (the table in BENCHMARKS.md restates this): huge G0/G1 with tiny relaxation times and
+coarse steps (no NaN, no oscillation, force between the relaxed and glass Hertz limits),
+sudden depth jumps in and out of contact (no NaN, dissipation never negative nor decreasing),
+force control at the JKR pull-off point (stable just above it, reported unstable just beyond,
+never NaN), and convergence of the pull-off force with element refinement.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from viscoadh_ros.core import reference
+from viscoadh_ros.core.config import SceneConfig
+from viscoadh_ros.core.rheology import CreepElement
+from viscoadh_ros.core.simulator import ContactSimulator, StepOutput
+
+# Each example runs a short history; a few dozen examples per property keep the file fast.
+EXAMPLES = settings(
+    max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow], derandomize=True
+)
+FIELDS = ("depth", "force", "contact_radius", "edge_speed", "energy_input", "energy_dissipated")
+
+
+def make_contact(
+    *,
+    radius: float,
+    glass: float,
+    kelvin: list[float],
+    viscosities: list[float],
+    work: float,
+    elements: int = 0,
+) -> Any:
+    """A sphere contact through the one scene loader; elements 0 keeps the preset's count."""
+    material: dict[str, Any] = {"glass_shear_modulus": glass}
+    if kelvin:
+        material.update(kelvin_shear_moduli=kelvin, kelvin_viscosities=viscosities)
+    numerics: dict[str, Any] = {"model": "time_stepped"}
+    if elements:
+        numerics["elements"] = elements
+    scene = SceneConfig.from_dict(
+        {
+            "contacts": ["x"],
+            "x": {
+                "indenter": {"shape": "sphere", "radius": radius},
+                "material": material,
+                "adhesion": {"work_of_adhesion": work},
+                "numerics": numerics,
+            },
+        }
+    )
+    return scene.contact("x")
+
+
+def run(contact: Any, time: np.ndarray, depth: np.ndarray) -> list[StepOutput]:
+    simulator = ContactSimulator(contact)
+    return [simulator.step(float(t), depth=float(d)) for t, d in zip(time, depth, strict=True)]
+
+
+def assert_finite(outputs: list[StepOutput], case: str) -> None:
+    for field in FIELDS:
+        values = np.array([getattr(o, field) for o in outputs])
+        assert np.all(np.isfinite(values)), f"{case}: {field} not finite: {values[~np.isfinite(values)][:3]}"
+
+
+def hertz(depth: np.ndarray, radius: float, shear_modulus: float) -> np.ndarray:
+    return reference.hertz_force(np.maximum(depth, 0.0), radius, 4.0 * shear_modulus)
+
+
+@EXAMPLES
+@given(
+    log_ratio=st.floats(0.0, 6.0),  # G0/G1 from 1 to 1e6
+    log_tau=st.floats(-6.0, 4.0),  # relaxation time 1e-6 .. 1e4 s
+    log_dt=st.floats(-6.0, 0.0),  # step 1e-6 .. 1 s
+    log_radius=st.floats(-6.0, 0.0),  # sphere radius 1e-6 .. 1 m
+)
+def test_ramp_hold_no_oscillation(log_ratio: float, log_tau: float, log_dt: float, log_radius: float) -> None:
+    """Non-adhesive ramp then hold, any step against any relaxation time: the force rises
+    monotonically on the ramp, relaxes monotonically on the hold, and stays between the relaxed
+    and the glass Hertz forces (a scheme that is not L-stable rings or overshoots here)."""
+    glass, radius, tau, dt = 1e6, 10.0**log_radius, 10.0**log_tau, 10.0**log_dt
+    g1 = glass / 10.0**log_ratio
+    case = f"G0/G1=1e{log_ratio:.2f} tau={tau:.2g} dt={dt:.2g} R={radius:.2g}"
+    contact = make_contact(
+        radius=radius, glass=glass, kelvin=[g1], viscosities=[tau * (glass + g1)], work=0.0
+    )
+    rows = 40
+    time = np.arange(1, 2 * rows + 1) * dt
+    depth = 1e-2 * radius * np.minimum(np.arange(1, 2 * rows + 1) / rows, 1.0)
+    outputs = run(contact, time, depth)
+    assert_finite(outputs, case)
+    force = np.array([o.force for o in outputs])
+    scale = float(hertz(depth[-1:], radius, glass)[0])
+    # Edge chatter of a few 1e-9 relative is round-off, not ringing; a real oscillation is far larger.
+    slack = 1e-6 * scale
+    assert np.all(np.diff(force[:rows]) >= -slack), f"{case}: force falls during the ramp"
+    assert np.all(np.diff(force[rows:]) <= slack), f"{case}: force rises during the hold"
+    relaxed_shear = glass * g1 / (glass + g1)
+    # 1% covers the discretisation of the contact edge at the preset's element count.
+    assert np.all(force <= hertz(depth, radius, glass) * 1.01 + slack), f"{case}: above the glass limit"
+    assert np.all(force >= hertz(depth, radius, relaxed_shear) * 0.99 - slack), f"{case}: below relaxed"
+
+
+@EXAMPLES
+@given(
+    jumps=st.lists(st.floats(-1.0, 3.0), min_size=3, max_size=12),
+    log_ratio=st.floats(0.0, 3.0),  # beyond 1e3: see the xfail below
+    log_tau=st.floats(-6.0, 1.0),
+    log_work=st.floats(-3.0, 1.0),  # work of adhesion 1e-3 .. 10 J/m^2
+)
+def test_depth_jumps_dissipation_never_negative(
+    jumps: list[float], log_ratio: float, log_tau: float, log_work: float
+) -> None:
+    """Depth held piecewise constant with sudden jumps in and out of contact (adhesive, any
+    rheology): outputs stay finite and the energy dissipated is never negative nor decreasing."""
+    glass, radius, work = 1e6, 1e-3, 10.0**log_work
+    g1, tau = glass / 10.0**log_ratio, 10.0**log_tau
+    case = f"jumps={np.round(jumps, 2).tolist()} G0/G1=1e{log_ratio:.2f} tau={tau:.2g} w={work:.2g}"
+    assert_dissipation_never_negative(
+        make_contact(radius=radius, glass=glass, kelvin=[g1], viscosities=[tau * (glass + g1)], work=work),
+        np.asarray(jumps),
+        tau / 3.0,
+        case,
+    )
+
+
+def assert_dissipation_never_negative(contact: Any, jumps: np.ndarray, step: float, case: str) -> None:
+    """Hold each depth of `jumps` (in units of the larger of 1e-3 R and the glass JKR depth)
+    for 10 steps of `step` s; dissipation must stay >= 0 and non-decreasing."""
+    radius, glass = contact.indenter.radius, contact.material.glass_shear_modulus
+    work = contact.adhesion.work_of_adhesion
+    glass_only = CreepElement(glass_shear_modulus=glass)
+    unit = max(1e-3 * radius, reference.figure4_scales(radius, work, glass_only).depth)
+    depth = np.repeat(jumps * unit, 10)
+    outputs = run(contact, np.arange(1, depth.size + 1) * step, depth)
+    assert_finite(outputs, case)
+    dissipated = np.array([o.energy_dissipated for o in outputs])
+    scale = max(
+        max(abs(o.energy_input) for o in outputs),
+        work * math.pi * max(o.contact_radius for o in outputs) ** 2,
+    )
+    # The edge is resolved to the preset's ~1% accuracy; an attachment or detachment step
+    # moves stored and surface energy by amounts known to that accuracy, so the bookkeeping
+    # balances to 1% of the energy scale, not to round-off.
+    tol = 1e-2 * scale + 1e-300
+    assert dissipated.min() >= -tol, f"{case}: dissipation {dissipated.min():.3g} J < 0 (scale {scale:.3g} J)"
+    assert np.all(np.diff(dissipated) >= -tol), f"{case}: dissipation decreases"
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="simulator bug (G0/G1 >= 1e4, adhesive): touching at zero depth gives a force of "
+    "-0.075 N where the instant neck gives about -(4/3) pi R w = -4.2e-3 N, and negative "
+    "dissipation (energy created); suspected cause: the domain is sized from the detachment "
+    "adhesion length (w G0/G_relaxed), leaving the first-touch neck inside one element",
+)
+def test_touch_at_zero_depth_huge_glass_ratio() -> None:
+    """Touching at zero depth and holding, G0/G1 = 1e4: dissipation must stay >= 0."""
+    glass = 1e6
+    contact = make_contact(radius=1e-3, glass=glass, kelvin=[glass / 1e4], viscosities=[glass], work=1.0)
+    assert_dissipation_never_negative(contact, np.zeros(3), 1.0 / 3.0, "G0/G1=1e4 touch at d=0")
+
+
+def _creep(contact: Any) -> CreepElement:
+    return CreepElement.from_config(contact.material)
+
+
+@settings(max_examples=10, deadline=None, derandomize=True)
+@given(log_work=st.floats(-3.0, 0.0), log_radius=st.floats(-4.0, -1.0), margin=st.floats(2e-2, 5e-2))
+def test_force_control_at_pull_off(log_work: float, log_radius: float, margin: float) -> None:
+    """Elastic JKR under force control, pulled to just above and just beyond the pull-off force
+    `-(3/2) pi R w` (margins above the preset's 0.5% pull-off accuracy): the first holds contact
+    and is stable, the second is reported unstable and leaves contact; never NaN."""
+    glass, radius, work = 1e6, 10.0**log_radius, 10.0**log_work
+    case = f"w={work:.3g} R={radius:.3g} margin={margin:.3g}"
+    contact = make_contact(radius=radius, glass=glass, kelvin=[], viscosities=[], work=work)
+    pull_off = reference.jkr_pull_off_force_control(radius, 4.0 * glass, work).force
+    for factor, expect_contact in ((1.0 - margin, True), (1.0 + margin, False)):
+        simulator = ContactSimulator(contact)
+        d_c = reference.figure4_scales(radius, work, _creep(contact)).depth
+        simulator.step(1e-3, depth=d_c)  # touch and snap in under displacement control
+        targets = np.linspace(simulator.output.force, factor * pull_off, 8)
+        outputs = [simulator.step(2e-3 + i * 1e-3, force=float(f)) for i, f in enumerate(targets)]
+        assert_finite(outputs, f"{case} factor={factor:.4f}")
+        last = outputs[-1]
+        if expect_contact:
+            assert last.contact_radius > 0.0 and not last.unstable, f"{case}: lost contact above pull-off"
+            np.testing.assert_allclose(last.force, factor * pull_off, rtol=1e-4, err_msg=case)
+        else:
+            assert any(o.unstable for o in outputs), f"{case}: pull-off beyond the limit not reported"
+            assert last.contact_radius == 0.0, f"{case}: still in contact beyond the pull-off force"
+
+
+@pytest.mark.parametrize("work", [0.01, 0.1, 1.0])
+def test_pull_off_converges_with_refinement(work: float) -> None:
+    """Elastic JKR pull-off on the time-stepped path: the error against `-(3/2) pi R w` falls as
+    the element count doubles, reaching 1% by 256 elements."""
+    glass, radius = 1e6, 1e-3
+    d_c = reference.figure4_scales(
+        radius, work, _creep(make_contact(radius=radius, glass=glass, kelvin=[], viscosities=[], work=work))
+    ).depth
+    time = np.linspace(0.0, 1.0, 801)
+    depth = np.interp(time, [0.0, 0.5, 1.0], [-0.5 * d_c, 2.0 * d_c, -3.0 * d_c])
+    exact = reference.jkr_pull_off_force_control(radius, 4.0 * glass, work).force
+    errors = []
+    for elements in (16, 32, 64, 128, 256):
+        contact = make_contact(
+            radius=radius, glass=glass, kelvin=[], viscosities=[], work=work, elements=elements
+        )
+        force = min(o.force for o in run(contact, time, depth))
+        errors.append(abs(force - exact) / abs(exact))
+    case = f"w={work} errors={np.round(errors, 5).tolist()}"
+    assert errors[-1] < 0.5 * errors[0], f"{case}: no convergence with refinement"
+    assert errors[-1] < 1e-2, f"{case}: not within 1% at 256 elements"
