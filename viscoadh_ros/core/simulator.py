@@ -186,11 +186,11 @@ class _ClosedForm:
 
     def _outer_root(self, depth: float) -> float:
         """Contact radius on the outer branch at `depth`, 0 if the branch does not reach it."""
-        if self.punch_radius is not None:
-            return self.punch_radius
         fold_radius, fold_depth = self._fold()
         if depth < fold_depth:
             return 0.0
+        if self.punch_radius is not None:
+            return self.punch_radius
         if self.physics.c_crit == 0.0:
             return float(self.physics.profile.radius_at_height(depth))
         hi = max(2.0 * fold_radius, float(self.physics.profile.radius_at_height(max(depth, 0.0))))

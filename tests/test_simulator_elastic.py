@@ -1,0 +1,152 @@
+"""Elastic contacts on both model paths against the closed forms (reference.py), at the
+default numerics: Hertz, Sneddon, flat punch, JKR approach/retraction and pull-off, Kendall."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from viscoadh_ros.core import reference
+from viscoadh_ros.core.config import SceneConfig
+from viscoadh_ros.core.errors import ConfigError
+from viscoadh_ros.core.simulator import ContactSimulator, Phase
+
+G0 = 1e6
+E0 = 4.0 * G0  # incompressible
+R = 1e-3
+MODELS = ["closed_form", "time_stepped"]
+
+
+def make_contact(indenter: dict, *, work: float = 0.0, model: str = "auto", kelvin=(), viscosities=()):
+    material = {"glass_shear_modulus": G0}
+    if kelvin:
+        material.update(kelvin_shear_moduli=list(kelvin), kelvin_viscosities=list(viscosities))
+    scene = SceneConfig.from_dict({"contacts": ["c"], "c": {
+        "indenter": indenter, "material": material, "adhesion": {"work_of_adhesion": work},
+        "numerics": {"model": model}}})
+    return scene.contact("c")
+
+
+def run_depth(contact, depth: np.ndarray, dt: float = 1e-3):
+    sim = ContactSimulator(contact)
+    return sim, [sim.step((i + 1) * dt, depth=float(d)) for i, d in enumerate(depth)]
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_hertz_sphere(model: str) -> None:
+    depth = np.linspace(0.0, 1e-5, 41)[1:]
+    sim, outputs = run_depth(make_contact({"shape": "sphere", "radius": R}, model=model), depth)
+    assert sim.model == model
+    force = np.array([o.force for o in outputs])
+    radius = np.array([o.contact_radius for o in outputs])
+    np.testing.assert_allclose(force, reference.hertz_force(depth, R, E0), rtol=5e-3, err_msg=f"Hertz force {model}")
+    np.testing.assert_allclose(radius, reference.hertz_radius(depth, R), rtol=5e-3, err_msg=f"Hertz radius {model}")
+    assert all(o.phase == Phase.INDENTING for o in outputs), model
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_sneddon_cone(model: str) -> None:
+    half_angle = 1.4
+    depth = np.linspace(0.0, 2e-6, 41)[1:]
+    _, outputs = run_depth(make_contact({"shape": "cone", "half_angle": half_angle}, model=model), depth)
+    force = np.array([o.force for o in outputs])
+    np.testing.assert_allclose(force, reference.sneddon_cone_force(depth, half_angle, E0), rtol=5e-3,
+                               err_msg=f"Sneddon force {model}")
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_flat_punch_stiffness(model: str) -> None:
+    depth = np.concatenate([np.linspace(0.0, 1e-6, 11), np.linspace(1e-6, 2e-7, 5)[1:]])
+    _, outputs = run_depth(make_contact({"shape": "flat_punch", "radius": R}, model=model), depth)
+    stiffness = np.array([o.force / o.depth for o in outputs if o.depth > 0.0])
+    expected = reference.flat_punch_stiffness(R, E0)
+    np.testing.assert_allclose(stiffness, expected, rtol=2e-3, err_msg=f"punch stiffness {model}")
+    assert all(o.contact_radius == pytest.approx(R, rel=1e-12) for o in outputs if o.depth > 0.0), model
+
+
+def _jkr_cycle(work: float) -> tuple[np.ndarray, float]:
+    pull = reference.jkr_pull_off_force_control(R, E0, work)
+    fold = reference.jkr_pull_off_displacement_control(R, E0, work)
+    up = np.linspace(fold.depth, 3.0 * abs(fold.depth), 200)
+    down = np.linspace(3.0 * abs(fold.depth), 1.5 * fold.depth, 700)
+    return np.concatenate([up, down[1:]]), abs(pull.force)
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_jkr_sphere_approach_and_retraction(model: str) -> None:
+    work = 0.05
+    depth, force_scale = _jkr_cycle(work)
+    _, outputs = run_depth(make_contact({"shape": "sphere", "radius": R}, work=work, model=model), depth)
+    peak = max(force_scale, max(abs(o.force) for o in outputs))
+    turn = int(np.argmax(depth))
+    approach, retraction = outputs[:turn], outputs[turn:]
+    # Approach: no contact until the indenter touches (d >= 0), then on the JKR curve.
+    assert all(o.contact_radius == 0.0 for o in approach if o.depth < 0.0), f"{model}: contact before touching"
+    fold = reference.jkr_pull_off_displacement_control(R, E0, work)
+    for branch, name in ((approach, "approach"), (retraction, "retraction")):
+        for o in branch:
+            if o.contact_radius == 0.0:
+                continue
+            case = f"{model} {name} d={o.depth:.4g}"
+            np.testing.assert_allclose(o.force, reference.jkr_force(o.contact_radius, R, E0, work), rtol=0,
+                                       atol=1e-2 * peak, err_msg=case)
+            np.testing.assert_allclose(o.depth, reference.jkr_depth(o.contact_radius, R, E0, work), rtol=0,
+                                       atol=1e-3 * abs(fold.depth), err_msg=case)
+    # Retraction holds contact below zero depth down to the fold, then lets go.
+    in_contact = [o.depth for o in retraction if o.contact_radius > 0.0]
+    assert min(in_contact) < 0.9 * fold.depth, f"{model}: let go before the fold"
+    assert retraction[-1].contact_radius == 0.0, f"{model}: never let go"
+    dissipated = [o.energy_dissipated for o in outputs]
+    assert min(dissipated) >= -1e-6 * max(dissipated), f"{model}: negative dissipation"
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_jkr_last_stable_point_under_displacement_control(model: str) -> None:
+    work = 0.05
+    fold = reference.jkr_pull_off_displacement_control(R, E0, work)
+    depth = np.concatenate([[2.0 * abs(fold.depth)], np.linspace(0.999 * fold.depth, 1.001 * fold.depth, 401)])
+    _, outputs = run_depth(make_contact({"shape": "sphere", "radius": R}, work=work, model=model), depth)
+    last = [o for o in outputs if o.contact_radius > 0.0][-1]
+    assert outputs[-1].contact_radius == 0.0, model
+    np.testing.assert_allclose(last.force, -(5.0 / 6.0) * math.pi * R * work, rtol=1e-2,
+                               err_msg=f"{model}: -(5/6) pi R w point")
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_jkr_pull_off_under_force_control(model: str) -> None:
+    work = 0.05
+    pull_off = reference.jkr_pull_off_force_control(R, E0, work).force
+    sim = ContactSimulator(make_contact({"shape": "sphere", "radius": R}, work=work, model=model))
+    sim.step(1e-3, depth=2.0 * abs(reference.jkr_pull_off_displacement_control(R, E0, work).depth))
+    targets = np.concatenate([np.linspace(sim.output.force, 0.9 * pull_off, 20),
+                              np.linspace(0.9 * pull_off, 1.05 * pull_off, 301)[1:]])
+    outputs = [sim.step(2e-3 + i * 1e-3, force=float(f)) for i, f in enumerate(targets)]
+    first_unstable = next(i for i, o in enumerate(outputs) if o.unstable)
+    stable = outputs[first_unstable - 1]
+    np.testing.assert_allclose(stable.force, targets[first_unstable - 1], rtol=1e-5, err_msg=f"{model}: tracking")
+    np.testing.assert_allclose(stable.force, pull_off, rtol=5e-3, err_msg=f"{model}: -(3/2) pi R w")
+    assert outputs[first_unstable].contact_radius == 0.0, f"{model}: still in contact after pull-off"
+    assert all(math.isfinite(o.depth) and math.isfinite(o.force) for o in outputs), model
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_kendall_flat_punch_pull_off(model: str) -> None:
+    work = 0.05
+    expected = reference.kendall_pull_off(R, E0, work)
+    d_off = expected / reference.flat_punch_stiffness(R, E0)
+    depth = np.concatenate([[1e-7], np.linspace(0.0, 1.2 * d_off, 241)])
+    _, outputs = run_depth(make_contact({"shape": "flat_punch", "radius": R}, work=work, model=model), depth)
+    np.testing.assert_allclose(min(o.force for o in outputs), expected, rtol=1e-2, err_msg=f"{model}: Kendall")
+    assert outputs[-1].contact_radius == 0.0, model
+
+
+def test_model_choice_and_override() -> None:
+    sphere = {"shape": "sphere", "radius": R}
+    assert ContactSimulator(make_contact(sphere)).model == "closed_form"
+    assert ContactSimulator(make_contact(sphere, model="time_stepped")).model == "time_stepped"
+    viscous = make_contact(sphere, kelvin=(1e5,), viscosities=(1e3,))
+    assert ContactSimulator(viscous).model == "time_stepped"
+    with pytest.raises(ConfigError, match="numerics.model"):
+        ContactSimulator(make_contact(sphere, model="closed_form", kelvin=(1e5,), viscosities=(1e3,)))
