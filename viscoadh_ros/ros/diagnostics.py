@@ -109,3 +109,22 @@ def diagnostic_array(
     msg = DiagnosticArray(status=statuses)
     msg.header.stamp = ns_to_stamp(stamp_ns)
     return msg
+
+
+def log_status(*, written: int, dropped: int, error: BaseException | None) -> DiagnosticStatus:
+    """The status of the MCAP log (``viscoadh: log``): ERROR when the writer stopped, WARN once
+    a message was dropped (the log is then incomplete for good), else OK."""
+    if error is not None:
+        level, message = DiagnosticStatus.ERROR, f"log writer stopped: {error}"
+    elif dropped:
+        level, message = DiagnosticStatus.WARN, f"{dropped} messages dropped (writer queue full)"
+    else:
+        level, message = DiagnosticStatus.OK, "OK"
+    values = {"messages_written": str(written), "messages_dropped": str(dropped)}
+    return DiagnosticStatus(
+        level=level,
+        name="viscoadh: log",
+        hardware_id="mcap",
+        message=message,
+        values=[KeyValue(key=k, value=v) for k, v in values.items()],
+    )

@@ -40,6 +40,7 @@ from viscoadh_ros.core.config import ContactConfig, SceneConfig
 from viscoadh_ros.core.errors import ConfigError, InputError
 from viscoadh_ros.core.history import predict_pull_off, simulate_history
 from viscoadh_ros.core.simulator import ContactSimulator, StepOutput
+from viscoadh_ros.io.mcap_log import McapRecorder
 from viscoadh_ros.ros import conversions, diagnostics, markers, parameters
 
 NODE_NAME = "viscoadh"
@@ -61,6 +62,18 @@ class Recorder(Protocol):
 
     def close(self) -> None:
         """Finish the log."""
+
+    @property
+    def dropped(self) -> int:
+        """Messages dropped so far (full queue or failed writer)."""
+
+    @property
+    def written(self) -> int:
+        """Messages written so far."""
+
+    @property
+    def error(self) -> BaseException | None:
+        """Why the writer stopped, if it did."""
 
 
 class _Contact:
@@ -328,8 +341,9 @@ class ViscoadhNode(Node):
         parameters.declare_scene(self, self.scene)
         self.frame_id = self.scene.node.frame_id
         self.markers_enabled = self.scene.node.markers_enabled
-        # MCAP logging (issue 5) plugs in here; None while logging is off.
-        self._recorder: Recorder | None = None
+        # MCAP logging; None while logging is off. Opened before the endpoints exist, so the
+        # log holds every command received and every state and wrench published.
+        self._recorder: Recorder | None = _open_recorder(self.scene)
         # Compile/load every numba kernel before the first command can arrive (~0.2 s).
         warm_up()
         warmed = time.perf_counter()
@@ -366,6 +380,14 @@ class ViscoadhNode(Node):
 
     def _publish_diagnostics(self) -> None:
         statuses = [contact.status() for contact in self.contacts.values()]
+        if self._recorder is not None:
+            statuses.append(
+                diagnostics.log_status(
+                    written=self._recorder.written,
+                    dropped=self._recorder.dropped,
+                    error=self._recorder.error,
+                )
+            )
         self.diagnostics_pub.publish(diagnostics.diagnostic_array(statuses, stamp_ns=self.now_ns()))
 
     def _on_set_parameters(self, changed: list[Parameter]) -> SetParametersResult:
@@ -416,6 +438,24 @@ class ViscoadhNode(Node):
             self._recorder.close()
             self._recorder = None
         super().destroy_node()
+
+
+def _open_recorder(scene: SceneConfig) -> McapRecorder | None:
+    """The MCAP recorder the scene's ``log.*`` parameters ask for (None when logging is off).
+
+    The whole scene goes into the file's metadata record, so the log alone replays the run.
+    """
+    node = scene.node
+    if not node.log_enabled:
+        return None
+    return McapRecorder(
+        node.log_path,
+        scene=scene.to_dict(),
+        chunk_size=node.log_chunk_size,
+        max_bytes=node.log_max_bytes,
+        max_duration=node.log_max_duration,
+        queue_size=node.log_queue_size,
+    )
 
 
 def _refuse(reason: str) -> SetParametersResult:
