@@ -11,7 +11,9 @@ Inputs (the control): ``viscoadh_msgs/msg/IndentationCommand`` (DEPTH or FORCE m
 (``wrench.force.z``, N) or ``std_msgs/msg/Float64`` (N), taken as the model's sign
 (> 0 compressive, pushing the indenter out; this is what the node publishes); ``flip_force``
 negates it for load cells that read tension positive. Times: ``header.stamp`` when the message
-has one (a zero stamp means "on receipt"), else the log time.
+has one (a zero stamp means "on receipt"), else the log time. Events of equal time run in the
+order they were recorded: a node log holds a hold-timer state stamped at a command's stamp
+before that command (the timer ran first) and the command's answer after it.
 """
 
 from __future__ import annotations
@@ -53,10 +55,12 @@ class Experiment:
 
     t0_ns: int
     input_ns: NDArray[np.int64]  # (n,) stamps of the inputs, non-decreasing
+    input_order: NDArray[np.int64]  # (n,) positions of the inputs in the recording
     input_mode: NDArray[np.uint8]  # (n,) DEPTH or FORCE
     input_value: NDArray[np.float64]  # (n,) depth, m, or force, N
     measured_ns: NDArray[np.int64]  # (m,) stamps of the measured force (m may be 0)
     measured_force: NDArray[np.float64]  # (m,) N, > 0 compressive
+    measured_order: NDArray[np.int64]  # (m,) positions of the force samples in the recording
     input_topic: str
     force_topic: str | None
 
@@ -148,18 +152,20 @@ def load_experiment(
                    FORCE_TYPES, "force", "--force-topic")
     if forces == inputs:
         raise InputError(f"the input and the force topic are both {inputs!r}")
-    rows = [(_stamp_ns(m), *_input_of(m)) for m in bag.messages([inputs])]
+    rows = [(_stamp_ns(m), m.order, *_input_of(m)) for m in bag.messages([inputs])]
     if not rows:
         raise InputError(f"input topic {inputs!r} has no messages")
-    rows.sort(key=lambda row: row[0])
+    rows.sort(key=lambda row: row[:2])
     input_ns = np.array([r[0] for r in rows], dtype=np.int64)
-    mode = np.array([r[1] for r in rows], dtype=np.uint8)
-    value = np.array([r[2] for r in rows], dtype=np.float64)
+    input_order = np.array([r[1] for r in rows], dtype=np.int64)
+    mode = np.array([r[2] for r in rows], dtype=np.uint8)
+    value = np.array([r[3] for r in rows], dtype=np.float64)
     if not np.all(np.isfinite(value)):
         raise InputError(f"input topic {inputs!r} holds non-finite values")
-    measured = sorted((_stamp_ns(m), _force_of(m)) for m in bag.messages([forces])) if forces else []
+    measured = sorted((_stamp_ns(m), m.order, _force_of(m)) for m in bag.messages([forces])) if forces else []
     measured_ns = np.array([m[0] for m in measured], dtype=np.int64)
-    force = np.array([m[1] for m in measured], dtype=np.float64) * (-1.0 if flip_force else 1.0)
+    measured_order = np.array([m[1] for m in measured], dtype=np.int64)
+    force = np.array([m[2] for m in measured], dtype=np.float64) * (-1.0 if flip_force else 1.0)
     # Measured samples before the first input have no model to compare with.
     keep = measured_ns >= input_ns[0]
     if forces and not np.any(keep):
@@ -172,10 +178,12 @@ def load_experiment(
     return Experiment(
         t0_ns=int(input_ns[0]),
         input_ns=input_ns,
+        input_order=input_order,
         input_mode=mode,
         input_value=value,
         measured_ns=measured_ns[keep],
         measured_force=force[keep],
+        measured_order=measured_order[keep],
         input_topic=inputs,
         force_topic=forces,
     )
@@ -225,8 +233,8 @@ def run_model(
     stamps = np.concatenate([experiment.input_ns, experiment.measured_ns])
     kinds = np.concatenate([np.zeros(n, np.int8), np.ones(m, np.int8)])
     index = np.concatenate([np.arange(n), np.arange(m)])
-    # By stamp; at equal stamps the input first, as the node publishes after stepping.
-    order = np.lexsort((kinds, stamps))
+    # By stamp; at equal stamps in recording order (see the module docstring).
+    order = np.lexsort((np.concatenate([experiment.input_order, experiment.measured_order]), stamps))
     times = experiment.time(stamps)
     sim = ContactSimulator(contact)
     outputs: list[StepOutput] = [None] * n  # type: ignore[list-item]

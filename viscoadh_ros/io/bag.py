@@ -27,19 +27,22 @@ from viscoadh_ros.io.ros_schemas import message_class
 
 @dataclass(frozen=True)
 class RecordedMessage:
-    """One deserialised message: ``log_time_ns`` is the recorder's clock, ns."""
+    """One deserialised message: ``log_time_ns`` is the recorder's clock, ns; ``order`` its
+    position in the recording (files in order, records in file order), which breaks ties of
+    equal times the way the recorder saw them."""
 
     topic: str
     type_name: str
     log_time_ns: int
     msg: Any
+    order: int
 
 
 @dataclass
 class _Topic:
     type_name: str
     encoding: str
-    raw: list[tuple[int, bytes]] = field(default_factory=list)
+    raw: list[tuple[int, int, bytes]] = field(default_factory=list)  # (log time, order, CDR)
 
 
 def _bag_files(path: Path) -> list[Path]:
@@ -84,6 +87,7 @@ class Bag:
         self.metadata: dict[str, dict[str, str]] = {}
         self.truncated: list[Path] = []
         self._topics: dict[str, _Topic] = {}
+        self._records = 0
         for file in self.files:
             self._read_file(file, recover)
 
@@ -123,7 +127,8 @@ class Bag:
             schema = schemas.get(channel.schema_id)
             type_name = schema.name if schema is not None else ""
             topic = self._topics[channel.topic] = _Topic(type_name, channel.message_encoding)
-        topic.raw.append((record.log_time, record.data))
+        topic.raw.append((record.log_time, self._records, record.data))
+        self._records += 1
 
     @property
     def topics(self) -> dict[str, str]:
@@ -154,21 +159,21 @@ class Bag:
         return sorted(t for t, info in self._topics.items() if info.type_name in type_names)
 
     def messages(self, topics: Iterable[str]) -> Iterator[RecordedMessage]:
-        """Decoded messages of ``topics`` in log-time order (stable for equal times)."""
+        """Decoded messages of ``topics`` in log-time order (recording order for equal times)."""
         streams = []
         for name in topics:
             topic = self._topics[name]
             if topic.encoding != "cdr":
                 raise InputError(f"topic {name!r} has message encoding {topic.encoding!r}, not cdr")
             cls = message_class(topic.type_name)
-            streams.extend((t, i, name, cls, data) for i, (t, data) in enumerate(topic.raw))
+            streams.extend((t, order, name, cls, data) for t, order, data in topic.raw)
         streams.sort(key=lambda item: (item[0], item[1]))
-        for log_time, _, name, cls, data in streams:
+        for log_time, order, name, cls, data in streams:
             try:
                 msg = deserialize_message(data, cls)
             except Exception as exc:  # noqa: BLE001 - rclpy raises plain exceptions on bad CDR
                 raise InputError(f"topic {name!r}: message at {log_time} ns does not decode ({exc})") from None
-            yield RecordedMessage(name, self._topics[name].type_name, log_time, msg)
+            yield RecordedMessage(name, self._topics[name].type_name, log_time, msg, order)
 
     def scene(self) -> dict[str, Any] | None:
         """The scene stored by our recorder (``SceneConfig.to_dict()`` form), if any."""

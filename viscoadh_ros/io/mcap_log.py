@@ -180,12 +180,7 @@ class McapRecorder:
             raise ConfigError(f"log.max_duration must be finite and >= 0 s (got {max_duration!r})")
         path = Path(path) if str(path) else Path(datetime.datetime.now().strftime("viscoadh_%Y_%m_%d-%H_%M_%S"))
         self._folder = None if path.suffix == ".mcap" else path
-        if self._folder is not None:
-            self._folder.mkdir(parents=True, exist_ok=True)
-            self._stem = self._folder / self._folder.name
-        else:
-            path.parent.mkdir(parents=True, exist_ok=True)
-            self._stem = path.with_suffix("")
+        self._stem = self._folder / self._folder.name if self._folder is not None else path.with_suffix("")
         self._rotating = max_bytes > 0 or max_duration > 0.0
         self._chunk_size = chunk_size
         self._max_bytes = max_bytes
@@ -201,7 +196,13 @@ class McapRecorder:
         self._closed = False
         self._error: BaseException | None = None
         self._finished: list[_File] = []
-        self._file: _File | None = None
+        # The first file is opened here, so an unwritable path fails at start, not silently
+        # in the writer thread.
+        try:
+            self._stem.parent.mkdir(parents=True, exist_ok=True)
+            self._file: _File | None = _File(self._next_path(), chunk_size=chunk_size, metadata=self._metadata)
+        except OSError as exc:
+            raise ConfigError(f"log.path {str(path)!r} cannot be written ({exc.strerror or exc})") from None
         self._types: dict[type, str] = {}
         self._thread = threading.Thread(target=self._run, name="viscoadh-mcap", daemon=True)
         self._thread.start()
