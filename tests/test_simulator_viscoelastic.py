@@ -1,0 +1,192 @@
+"""Viscoelastic contacts on the time-stepped path against the paper's quasistatic limits and
+Lee-Radok, plus the simulator's mechanics: sub-stepping, domain growth, idling, snapshots,
+force control, pull-off prediction and bad input."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from viscoadh_ros.core import reference
+from viscoadh_ros.core.config import SceneConfig
+from viscoadh_ros.core.errors import InputError
+from viscoadh_ros.core.history import predict_pull_off, simulate_history
+from viscoadh_ros.core.rheology import CreepElement
+from viscoadh_ros.core.simulator import ContactSimulator, Phase
+
+G0, G1, TAU = 1e6, 1e5, 1e-2
+R = 1e-3
+
+
+def make_contact(*, kelvin=(G1,), viscosities=(TAU * (G0 + G1),), work=0.0, shape="sphere", **numerics):
+    material = {"glass_shear_modulus": G0}
+    if kelvin:
+        material.update(kelvin_shear_moduli=list(kelvin), kelvin_viscosities=list(viscosities))
+    scene = SceneConfig.from_dict({"contacts": ["c"], "c": {
+        "indenter": {"shape": shape, "radius": R}, "material": material,
+        "adhesion": {"work_of_adhesion": work}, "numerics": {"model": "time_stepped", **numerics}}})
+    return scene.contact("c")
+
+
+def test_standard_solid_quasistatic_cycle() -> None:
+    """Slow against tau: indentation on JKR(E_r*, w_eff1), a sticking zone at constant radius
+    after reversal, detachment on JKR(E_r*, w_eff2), pull-off -(3/2) pi R w_eff2."""
+    work = 0.05
+    contact = make_contact(work=work)
+    element = CreepElement.from_config(contact.material)
+    e_r = element.relaxed_modulus_star
+    w1, w2 = work * G1 / (G0 + G1), work * (G0 + G1) / G1
+    scales = reference.figure4_scales(R, work, element)
+    depth = np.concatenate([np.linspace(-0.1, 4.0, 400), np.linspace(4.0, -3.0, 1000)[1:]]) * scales.depth
+    time = np.linspace(0.0, 2e4, depth.size)  # steps of ~14 s = 1400 tau
+    result = simulate_history(contact, time, depth=depth)
+    f_c = abs(scales.force)
+    touch = int(np.argmax(result.contact_radius > 0.0))
+    turn = int(np.argmax(depth))
+    for i in range(touch + 2, result.depth.size):
+        a, phase = result.contact_radius[i], result.phase[i]
+        if a == 0.0 or phase == Phase.STICKING:
+            continue
+        w_eff = w1 if i <= turn else w2
+        case = f"row {i} phase {phase} d/d_c={depth[i] / scales.depth:.3f}"
+        assert phase == (Phase.INDENTING if i <= turn else Phase.DETACHING), case
+        np.testing.assert_allclose(result.force[i], reference.jkr_force(a, R, e_r, w_eff), rtol=0,
+                                   atol=1e-2 * f_c, err_msg=case)
+        np.testing.assert_allclose(result.effective_work_of_adhesion[i], w_eff, rtol=2e-2, err_msg=case)
+    sticking = np.flatnonzero(result.phase == Phase.STICKING)
+    assert sticking.size > 100 and sticking[0] == turn + 1, "no sticking zone right after reversal"
+    a_max = result.contact_radius[turn]
+    np.testing.assert_array_equal(result.contact_radius[sticking], a_max, err_msg="radius moves while sticking")
+    # Sticking ends where the relaxed edge reaches the detachment criterion: JKR(E_r*, w_eff2).
+    end = sticking[-1] + 1
+    step = abs(depth[1] - depth[0]) * 3
+    np.testing.assert_allclose(depth[end], reference.jkr_depth(a_max, R, e_r, w2), rtol=0, atol=step,
+                               err_msg="end of the sticking zone")
+    np.testing.assert_allclose(result.force.min(), -1.5 * math.pi * R * w2, rtol=2e-2, err_msg="pull-off")
+    assert result.contact_radius[-1] == 0.0
+    assert np.all(result.energy_dissipated >= -1e-9 * result.energy_input.max()), "negative dissipation"
+
+
+@pytest.mark.parametrize(("kelvin", "viscosities"), [((G1,), (TAU * (G0 + G1),)),
+                                                      ((3e5, 1e5, 5e5), (1e2, 1e3, 1e0))])
+def test_lee_radok_ramp(kelvin, viscosities) -> None:
+    """Non-adhesive ramp d = v t against the exact hereditary integral."""
+    contact = make_contact(kelvin=kelvin, viscosities=viscosities)
+    element = CreepElement.from_config(contact.material)
+    t_end = 5.0 * float(np.max(element.relaxation_times))
+    speed = 1e-5 / t_end
+    time = np.linspace(0.0, t_end, 201)[1:]
+    result = simulate_history(contact, np.concatenate([[0.0], time]), depth=np.concatenate([[0.0], speed * time]))
+    expected = reference.lee_radok_ramp_force(time, speed, R, element)
+    np.testing.assert_allclose(result.force[1:], expected, rtol=5e-3, err_msg=f"Lee-Radok K={len(kelvin)}")
+
+
+def test_coarse_history_converges_to_fine() -> None:
+    """An adhesive cycle given at 25 rows, and the same piecewise-linear path at 2401 rows:
+    the internal substeps make the coarse run land on the fine one."""
+    work = 0.05
+    contact = make_contact(work=work)
+    d_c = reference.figure4_scales(R, work, CreepElement.from_config(contact.material)).depth
+    coarse_time = np.linspace(0.0, 20 * TAU, 25)
+    coarse_depth = d_c * (3.0 * np.sin(np.pi * coarse_time / coarse_time[-1]) - 0.5)
+    fine_time = np.linspace(0.0, 20 * TAU, 2401)
+    coarse = simulate_history(contact, coarse_time, depth=coarse_depth)
+    fine = simulate_history(contact, fine_time, depth=np.interp(fine_time, coarse_time, coarse_depth))
+    np.testing.assert_allclose(coarse.force, fine.force[::100], rtol=0, atol=5e-3 * np.abs(fine.force).max(),
+                               err_msg="coarse vs fine rows")
+
+
+def test_domain_grows_instead_of_clipping() -> None:
+    """A domain far smaller than the contact grows (memory remapped): same answer as a big one."""
+    depth = np.linspace(0.0, 2e-5, 60)[1:]
+    time = np.linspace(0.0, 5 * TAU, depth.size)
+    small = ContactSimulator(make_contact(domain_radius=1e-6))
+    big = ContactSimulator(make_contact(domain_radius=2e-4))
+    for t, d in zip(time, depth):
+        out_small, out_big = small.step(float(t), depth=float(d)), big.step(float(t), depth=float(d))
+    assert small._model.row.length >= out_small.contact_radius > 1e-6
+    np.testing.assert_allclose(out_small.force, out_big.force, rtol=5e-3, err_msg="grown vs big domain")
+    elastic = ContactSimulator(make_contact(kelvin=(), viscosities=(), domain_radius=1e-6))
+    out = elastic.step(1.0, depth=2e-5)
+    np.testing.assert_allclose(out.force, reference.hertz_force(2e-5, R, 4 * G0), rtol=5e-3, err_msg="grown Hertz")
+
+
+def test_idle_contact_costs_nothing_and_keeps_no_memory() -> None:
+    sim = ContactSimulator(make_contact(work=0.05))
+    sim.step(0.01, depth=1e-6)
+    assert sim.in_contact and not sim.is_idle
+    sim.step(0.02, depth=-1e-5)
+    assert not sim.in_contact
+    assert not sim.is_idle, "memory right after detaching must be remembered"
+    sim.step(100.0, depth=-1e-5)  # 1e4 tau: relaxed
+    assert sim.is_idle
+    out = sim.step(200.0, depth=-2e-5)
+    assert sim._model.row is None and out.force == 0.0 and out.phase == Phase.NO_CONTACT
+
+
+def test_snapshot_restore_is_exact_and_independent() -> None:
+    contact = make_contact(work=0.05)
+    sim = ContactSimulator(contact)
+    for i in range(1, 20):
+        sim.step(i * 1e-3, depth=i * 2e-7)
+    snap = sim.snapshot()
+    first = [sim.step(0.02 + i * 1e-3, depth=4e-6 - i * 5e-7) for i in range(10)]
+    sim.restore(snap)
+    other = ContactSimulator(contact)
+    other.restore(snap)
+    again = [sim.step(0.02 + i * 1e-3, depth=4e-6 - i * 5e-7) for i in range(10)]
+    assert first == again
+    # The other simulator starts from the same state but owns its arrays.
+    elsewhere = [other.step(0.02 + i * 1e-3, depth=4e-6 - i * 5e-7) for i in range(10)]
+    assert elsewhere == first
+    assert sim.output == first[-1]
+
+
+def test_predict_pull_off_leaves_the_live_state_alone() -> None:
+    work = 0.05
+    sim = ContactSimulator(make_contact(kelvin=(), viscosities=(), work=work))
+    sim.step(1e-3, depth=3e-6)
+    before = sim.output
+    prediction = predict_pull_off(sim, retract_speed=1e-3)
+    assert sim.output == before and sim.time == before.time
+    assert prediction.detached and "detached" in prediction.message
+    np.testing.assert_allclose(prediction.pull_off_force, -1.5 * math.pi * R * work, rtol=1e-2,
+                               err_msg="elastic pull-off by retraction")
+    assert prediction.time_to_detach > 0.0 and prediction.pull_off_depth < 3e-6
+    assert sim.step(2e-3, depth=3e-6).force == pytest.approx(before.force, rel=1e-9)
+    with pytest.raises(InputError, match="retract_speed"):
+        predict_pull_off(sim, retract_speed=0.0)
+
+
+def test_force_control_creeps_under_constant_load() -> None:
+    sim = ContactSimulator(make_contact())
+    outputs = [sim.step(i * TAU / 5, force=1e-3) for i in range(1, 40)]
+    depth = np.array([o.depth for o in outputs])
+    assert np.all(np.diff(depth) > 0.0), "no creep under constant force"
+    np.testing.assert_allclose([o.force for o in outputs], 1e-3, rtol=1e-5, err_msg="force tracking")
+    # Long-time limit: Hertz with the relaxed modulus.
+    e_r = CreepElement.from_config(make_contact().material).relaxed_modulus_star
+    relaxed_depth = (3e-3 / (4 * e_r * math.sqrt(R))) ** (2 / 3)
+    out = sim.step(100.0, force=1e-3)
+    np.testing.assert_allclose(out.depth, relaxed_depth, rtol=2e-3, err_msg="relaxed creep depth")
+
+
+def test_bad_input_names_the_parameter_and_changes_nothing() -> None:
+    sim = ContactSimulator(make_contact())
+    sim.step(0.01, depth=1e-6)
+    before = sim.output
+    for kwargs, match in (({"depth": math.nan}, "depth"), ({"force": math.inf}, "force"),
+                          ({"depth": 1e-6, "force": 1.0}, "exactly one"), ({}, "exactly one")):
+        with pytest.raises(InputError, match=match):
+            sim.step(0.02, **kwargs)
+    with pytest.raises(InputError, match="time"):
+        sim.step(0.005, depth=1e-6)
+    assert sim.output == before
+    with pytest.raises(InputError, match="time"):
+        simulate_history(make_contact(), [0.0, 0.1, 0.1], depth=[0.0, 1e-6, 2e-6])
+    with pytest.raises(InputError, match="depth"):
+        simulate_history(make_contact(), [0.0, 0.1], depth=[0.0])
+    with pytest.raises(InputError, match=r"force\[1\]"):
+        simulate_history(make_contact(), [0.0, 0.1], force=[0.0, math.nan])
