@@ -6,6 +6,7 @@ plotted by `viscoadh plot`."""
 from __future__ import annotations
 
 import json
+import time
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -19,6 +20,7 @@ from geometry_msgs.msg import WrenchStamped
 from mcap.reader import make_reader
 from rclpy.node import Node
 from rclpy.serialization import deserialize_message
+from rosgraph_msgs.msg import Clock
 from viscoadh_msgs.msg import ContactState, IndentationCommand
 
 from viscoadh_ros import __version__
@@ -27,7 +29,7 @@ from viscoadh_ros.core.config import SceneConfig
 from viscoadh_ros.demo import _Driver, node_in_process
 from viscoadh_ros.io.bag import Bag
 from viscoadh_ros.io.mcap_log import METADATA_NAME, SCENE_KEY, VERSION_KEY
-from viscoadh_ros.ros.conversions import stamp_to_ns
+from viscoadh_ros.ros.conversions import ns_to_stamp, stamp_to_ns
 
 #: A standard-solid sphere (time-stepped model); the hold timer runs at its default 50 Hz, so
 #: the log holds timer states between the commands too.
@@ -46,7 +48,9 @@ SCENE = SceneConfig.from_parameters(
 START_S = 1.0  # simulated clock at the first command, s
 #: Commands every 10 ms: press to 20 um in 0.3 s, hold 0.1 s, pull out to -30 um in 0.5 s,
 #: then two idle commands 0.6 s apart so /diagnostics (1 Hz on the node clock) comes due.
-TIMES = np.concatenate([np.arange(0.0, 0.9, 0.01), [1.5, 2.1]])
+TIMES = np.concatenate([np.arange(0.0, 0.3, 0.01), [0.4], np.arange(0.41, 0.9, 0.01), [1.5, 2.1]])
+#: During the hold the clock alone moves on, so the node's hold timer publishes the relaxation.
+HOLD_TICKS = np.arange(0.32, 0.4, 0.02)
 DEPTHS = np.interp(TIMES, [0.0, 0.3, 0.4, 0.9], [-1e-6, 20e-6, 20e-6, -30e-6])
 
 
@@ -70,7 +74,14 @@ def node_run(tmp_path_factory: pytest.TempPathFactory) -> Iterator[NodeRun]:
         executor.add_node(client)
         driver = _Driver(client, "finger", timeout=10.0)
         driver.wait_for_node()
-        answers = [driver.command(START_S + t, d) for t, d in zip(TIMES, DEPTHS, strict=True)]
+        clock = client.create_publisher(Clock, "/clock", 1)
+        answers = []
+        for t, d in zip(TIMES, DEPTHS, strict=True):
+            if np.isclose(t, 0.4):  # the end of the hold
+                for tick in HOLD_TICKS:
+                    clock.publish(Clock(clock=ns_to_stamp(round((START_S + tick) * 1e9))))
+                    time.sleep(0.05)  # wall time for the node's timer to fire on the new clock
+            answers.append(driver.command(START_S + t, d))
     yield NodeRun(log, answers, diagnostics)
 
 
@@ -100,7 +111,7 @@ def test_node_log_holds_every_command_state_and_wrench(node_run: NodeRun) -> Non
 
     states = [deserialize_message(data, ContactState) for _, data in topics["/finger/state"]]
     wrenches = [deserialize_message(data, WrenchStamped) for _, data in topics["/finger/wrench"]]
-    assert len(states) == len(wrenches) >= len(commands), "every answer is logged"
+    assert len(states) == len(wrenches) > len(commands), "hold-timer states are logged as well as answers"
     np.testing.assert_array_equal(
         [w.wrench.force.z for w in wrenches], [s.force for s in states], err_msg="wrench z = state force"
     )
@@ -150,8 +161,17 @@ def test_replay_of_node_log_reproduces_its_forces(node_run: NodeRun, tmp_path: P
     printed = capsys.readouterr().out
     summary = json.loads(summary_path.read_text())
     assert set(summary) == {
-        "bag", "contact", "input_topic", "force_topic", "output", "samples", "rmse_N", "max_error_N",
-        "measured_pull_off_force_N", "model_pull_off_force_N", "replay_speed_x_real_time",
+        "bag",
+        "contact",
+        "input_topic",
+        "force_topic",
+        "output",
+        "samples",
+        "rmse_N",
+        "max_error_N",
+        "measured_pull_off_force_N",
+        "model_pull_off_force_N",
+        "replay_speed_x_real_time",
     }
     assert summary["contact"] == "finger" and summary["force_topic"] == "/finger/wrench"
     logged = Bag(node_run.log)
@@ -166,7 +186,10 @@ def test_replay_of_node_log_reproduces_its_forces(node_run: NodeRun, tmp_path: P
     states = [m.msg for m in replayed.messages(["/finger/state"])]
     assert len(states) == len(TIMES) == replayed.message_count("/finger/wrench")
     np.testing.assert_allclose(
-        [s.force for s in states], [a.force for a in node_run.answers], rtol=1e-9, atol=1e-15,
+        [s.force for s in states],
+        [a.force for a in node_run.answers],
+        rtol=1e-9,
+        atol=1e-15,
         err_msg="replayed state at each command = the node's answer",
     )
 
