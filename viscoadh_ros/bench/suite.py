@@ -1,0 +1,136 @@
+"""The benchmark plan of `viscoadh bench`: which sizes each section runs at, quick or full."""
+
+from __future__ import annotations
+
+import datetime
+import os
+import platform
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+SECTIONS = ("kernel", "accuracy", "node", "replay")
+
+
+@dataclass(frozen=True)
+class Plan:
+    """Sizes of one bench run. Quick keeps the whole run under about three minutes."""
+
+    kernel_elements: tuple[int, ...]
+    kernel_kelvin: tuple[int, ...]
+    kernel_steps: int
+    kernel_repeats: int
+    accuracy_elements: tuple[int, ...]
+    accuracy_rows: tuple[int, ...]
+    accuracy_repeats: int
+    preset_rows: int
+    node_contacts: int
+    node_duration_s: float
+    replay_seconds: float
+    replay_repeats: int
+
+
+FULL = Plan(
+    kernel_elements=(64, 128, 256, 512, 1024, 2048, 4096),
+    kernel_kelvin=(0, 1, 4),
+    kernel_steps=2000,
+    kernel_repeats=7,
+    accuracy_elements=(32, 64, 128, 256, 512, 1024),
+    accuracy_rows=(251, 1001, 4001),
+    accuracy_repeats=3,
+    preset_rows=1001,
+    node_contacts=4,
+    node_duration_s=30.0,
+    replay_seconds=60.0,
+    replay_repeats=3,
+)
+QUICK = Plan(
+    kernel_elements=(64, 256, 1024, 4096),
+    kernel_kelvin=(0, 1, 4),
+    kernel_steps=500,
+    kernel_repeats=3,
+    accuracy_elements=(64, 256),
+    accuracy_rows=(251, 1001),
+    accuracy_repeats=1,
+    preset_rows=1001,
+    node_contacts=4,
+    node_duration_s=5.0,
+    replay_seconds=10.0,
+    replay_repeats=1,
+)
+
+
+def machine_description() -> str:
+    """CPU count, processor and Python of this machine, for the report header."""
+    return (
+        f"{os.cpu_count()} CPUs, {platform.processor() or platform.machine()}, "
+        f"{platform.system()} {platform.release()}, Python {platform.python_version()}"
+    )
+
+
+def run(
+    plan: Plan,
+    *,
+    sections: Sequence[str],
+    soak_minutes: float | None,
+    command: str,
+    progress: Callable[[str], None],
+) -> dict[str, Any]:
+    """Run the chosen sections (plus the soak when asked) and return the results dictionary."""
+    unknown = sorted(set(sections) - set(SECTIONS))
+    if unknown:
+        raise ValueError(f"sections: unknown {', '.join(unknown)} (known: {', '.join(SECTIONS)})")
+    results: dict[str, Any] = {
+        "command": command,
+        "date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
+        "machine": machine_description(),
+        "quick": plan is QUICK,
+    }
+    if "kernel" in sections:
+        from viscoadh_ros.bench.kernel import kernel_table
+
+        progress("kernel: compiling and timing")
+        results["kernel"] = kernel_table(
+            elements=plan.kernel_elements,
+            kelvin=plan.kernel_kelvin,
+            steps=plan.kernel_steps,
+            repeats=plan.kernel_repeats,
+        )
+    if "accuracy" in sections:
+        from viscoadh_ros.bench.accuracy import accuracy_grid, preset_table, reference_forces
+        from viscoadh_ros.core.presets import PRESET_NAMES
+
+        progress("accuracy: reference runs")
+        references = reference_forces()
+        progress("accuracy: grid over elements and steps")
+        results["accuracy"] = accuracy_grid(
+            references=references,
+            preset="balanced",
+            elements=plan.accuracy_elements,
+            rows=plan.accuracy_rows,
+            repeats=plan.accuracy_repeats,
+        )
+        progress("accuracy: presets")
+        results["presets"] = preset_table(
+            references=references,
+            presets=PRESET_NAMES,
+            rows=plan.preset_rows,
+            repeats=plan.accuracy_repeats,
+        )
+    if "node" in sections:
+        from viscoadh_ros.bench.latency import node_benchmark
+
+        progress(f"node: {plan.node_duration_s:g} s of 1 kHz commands, node then echo")
+        results["node"] = node_benchmark(contacts=plan.node_contacts, duration_s=plan.node_duration_s)
+        results["startup_s"] = results["node"]["startup_s"]
+    if "replay" in sections:
+        from viscoadh_ros.bench.replay_speed import replay_benchmark
+
+        progress(f"replay: {plan.replay_seconds:g} s of 1 kHz commands")
+        results["replay"] = replay_benchmark(seconds=plan.replay_seconds, repeats=plan.replay_repeats)
+    if soak_minutes is not None:
+        from viscoadh_ros.bench.soak import soak
+
+        progress(f"soak: {soak_minutes:g} min on 8 contacts with logging on")
+        results["soak"] = soak(minutes=soak_minutes)
+    return results

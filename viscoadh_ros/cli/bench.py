@@ -1,0 +1,144 @@
+"""`viscoadh bench`: measure speed and accuracy on this machine, write BENCHMARKS.md and JSON.
+
+    viscoadh bench [--quick] [--json FILE] [--output FILE] [--soak MINUTES] [--sections LIST]
+
+A full run writes BENCHMARKS.md (tables, with the accuracy figure under the JSON's folder) and
+benchmarks/results.json; `--quick` (under about three minutes) writes only what is asked for
+with --json/--output and prints a summary. Each file records the command line that made it.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import shlex
+import sys
+from pathlib import Path
+
+DEFAULT_OUTPUT = Path("BENCHMARKS.md")
+DEFAULT_JSON = Path("benchmarks/results.json")
+FIGURE_NAME = "accuracy_pareto.png"
+
+
+def _positive_minutes(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"--soak must be a number of minutes (got {text!r})") from None
+    if not value > 0.0 or not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"--soak must be > 0 minutes (got {text!r})")
+    return value
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    from viscoadh_ros.bench.suite import SECTIONS
+
+    parser.add_argument("--quick", action="store_true", help="small sizes and short runs (< 3 min)")
+    parser.add_argument("--json", type=Path, help=f"results JSON (default for a full run: {DEFAULT_JSON})")
+    parser.add_argument(
+        "--output", type=Path, help=f"report Markdown (default for a full run: {DEFAULT_OUTPUT})"
+    )
+    parser.add_argument(
+        "--soak",
+        type=_positive_minutes,
+        metavar="MINUTES",
+        help="also run the node for MINUTES under 1 kHz on 8 contacts with logging on",
+    )
+    parser.add_argument(
+        "--sections",
+        default=",".join(SECTIONS),
+        help=f"comma-separated sections to run (default: all of {','.join(SECTIONS)})",
+    )
+
+
+def _summary(results: dict) -> str:
+    lines = []
+    if "kernel" in results:
+        worst = max(
+            (k for k in results["kernel"] if k["elements"] >= 256), key=lambda k: k["ratio"], default=None
+        )
+        if worst is not None:
+            lines.append(
+                f"kernel: worst ratio to the bare loop at >= 256 elements {worst['ratio']:.3g} "
+                f"({worst['elements']} elements, K={worst['kelvin']})"
+            )
+    for preset in results.get("presets", []):
+        lines.append(
+            f"preset {preset['preset']:>8} {preset['case']:<24} error {preset['rel_error']:.3g} "
+            f"cost {preset['us_per_step']:.3g} us/step"
+        )
+    if "node" in results:
+        node = results["node"]
+        lines.append(
+            f"node: p50 {node['latency_p50_ms']:.3g} ms, p99 {node['latency_p99_ms']:.3g} ms "
+            f"(echo {node['echo_p99_ms']:.3g} ms, ratio {node['p99_ratio']:.3g}), "
+            f"misses {node['deadline_miss_fraction']:.3g}, start-up {node['startup_s']:.3g} s"
+        )
+    if "replay" in results:
+        lines.append(f"replay: {results['replay']['realtime_factor']:.3g}x real time")
+    if "soak" in results:
+        soak = results["soak"]
+        lines.append(
+            f"soak: memory {soak['memory_growth']:+.2%}, dropped {soak['dropped']}, "
+            f"p99 drift {soak['p99_drift']:+.2%}"
+        )
+    return "\n".join(lines)
+
+
+def _command_line(args: argparse.Namespace, sections: list[str]) -> str:
+    """The command that reproduces this run, rebuilt from the parsed options."""
+    from viscoadh_ros.bench.suite import SECTIONS
+
+    words = ["viscoadh", "bench"]
+    if args.quick:
+        words.append("--quick")
+    for flag, value in (("--json", args.json), ("--output", args.output), ("--soak", args.soak)):
+        if value is not None:
+            words += [flag, str(value)]
+    if tuple(sections) != SECTIONS:
+        words += ["--sections", ",".join(sections)]
+    return shlex.join(words)
+
+
+def main(args: argparse.Namespace) -> int:
+    from viscoadh_ros.bench import report, suite
+
+    sections = [s.strip() for s in args.sections.split(",") if s.strip()]
+    unknown = sorted(set(sections) - set(suite.SECTIONS))
+    if unknown:
+        print(
+            f"viscoadh bench: error: --sections: unknown {', '.join(unknown)} "
+            f"(known: {', '.join(suite.SECTIONS)})",
+            file=sys.stderr,
+        )
+        return 2
+    json_path = args.json if args.json is not None or args.quick else DEFAULT_JSON
+    output = args.output if args.output is not None or args.quick else DEFAULT_OUTPUT
+    command = _command_line(args, sections)
+    try:
+        results = suite.run(
+            suite.QUICK if args.quick else suite.FULL,
+            sections=sections,
+            soak_minutes=args.soak,
+            command=command,
+            progress=lambda message: print(f"viscoadh bench: {message}", file=sys.stderr, flush=True),
+        )
+    except RuntimeError as exc:
+        print(f"viscoadh bench: error: {exc}", file=sys.stderr)
+        return 1
+    figure = None
+    if output is not None and "accuracy" in results:
+        figure_dir = (json_path or DEFAULT_JSON).parent
+        figure = figure_dir / FIGURE_NAME
+        report.accuracy_figure(results, figure)
+    if json_path is not None:
+        json_path.parent.mkdir(parents=True, exist_ok=True)
+        json_path.write_text(json.dumps(results, indent=2) + "\n", encoding="utf-8")
+    if output is not None:
+        link = Path(os.path.relpath(figure, output.parent)) if figure is not None else None
+        output.parent.mkdir(parents=True, exist_ok=True)
+        output.write_text(report.render_markdown(results, link), encoding="utf-8")
+    print(_summary(results))
+    return 0
