@@ -1,0 +1,100 @@
+"""`viscoadh simulate`: history CSV in, result CSV out, one-line errors."""
+
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from viscoadh_ros.cli.main import main
+from viscoadh_ros.core import reference
+from viscoadh_ros.core.simulator import STEP_OUTPUT_FIELDS
+
+SCENE = """\
+/**:
+  ros__parameters:
+    contacts: [finger, probe]
+    finger:
+      indenter: {shape: sphere, radius: 0.001}
+      material: {glass_shear_modulus: 1.0e6}
+    probe:
+      indenter: {shape: sphere, radius: 0.001}
+      material: {glass_shear_modulus: 1.0e6, kelvin_shear_moduli: [1.0e5], kelvin_viscosities: [1.1e4]}
+      adhesion: {work_of_adhesion: 0.05}
+"""
+
+
+@pytest.fixture
+def scene(tmp_path: Path) -> Path:
+    path = tmp_path / "scene.yaml"
+    path.write_text(SCENE)
+    return path
+
+
+def write_history(path: Path, header: str, rows: np.ndarray) -> Path:
+    path.write_text(header + "\n" + "\n".join(f"{float(a)!r},{float(b)!r}" for a, b in rows) + "\n")
+    return path
+
+
+def read_result(path: Path) -> dict[str, np.ndarray]:
+    with open(path, newline="") as handle:
+        rows = list(csv.reader(handle))
+    assert tuple(rows[0]) == STEP_OUTPUT_FIELDS
+    table = np.array(rows[1:], dtype=np.float64)
+    return {name: table[:, i] for i, name in enumerate(rows[0])}
+
+
+def test_depth_history_gives_hertz(scene: Path, tmp_path: Path, capsys) -> None:
+    time = np.linspace(0.0, 1.0, 21)
+    depth = np.linspace(0.0, 1e-5, 21)
+    history = write_history(tmp_path / "h.csv", "time,depth", np.c_[time, depth])
+    out = tmp_path / "out.csv"
+    assert main(["simulate", str(scene), str(history), "-o", str(out), "--contact", "finger",
+                 "--model", "time_stepped"]) == 0
+    assert "time_stepped" in capsys.readouterr().out
+    result = read_result(out)
+    assert result["time"].size == 21
+    np.testing.assert_allclose(result["depth"], depth, rtol=0, atol=0, err_msg="depth column")
+    np.testing.assert_allclose(result["force"], reference.hertz_force(depth, 1e-3, 4e6), rtol=5e-3, atol=1e-12,
+                               err_msg="Hertz through the CLI")
+    assert set(np.unique(result["phase"])) <= {0.0, 1.0}
+
+
+def test_force_history_and_preset(scene: Path, tmp_path: Path) -> None:
+    time = np.linspace(0.0, 0.1, 11)
+    force = np.linspace(0.0, 1e-3, 11)
+    history = write_history(tmp_path / "h.csv", "time,force", np.c_[time, force])
+    out = tmp_path / "out.csv"
+    assert main(["simulate", str(scene), str(history), "-o", str(out), "--contact", "probe", "--preset", "fast"]) == 0
+    result = read_result(out)
+    in_contact = result["contact_radius"] > 0.0
+    np.testing.assert_allclose(result["force"][in_contact], force[in_contact], rtol=1e-3, atol=1e-9,
+                               err_msg="force tracking")
+
+
+@pytest.mark.parametrize(("content", "message"), [
+    ("time,height\n0,1\n", "header must be"),
+    ("time,depth\n0,1e-6\n0.1,abc\n", ":3: column 'depth' is not a number"),
+    ("time,depth\n0,1e-6\n0.1,nan\n", ":3: column 'depth' must be finite"),
+    ("time,depth\n0,1e-6\n0,2e-6\n", ":3: column 'time' must increase"),
+    ("time,depth\n0,1e-6,3\n", ":2: expected 2 columns"),
+    ("time,depth\n", "no samples"),
+])
+def test_bad_history_is_one_line_error(scene: Path, tmp_path: Path, capsys, content: str, message: str) -> None:
+    history = tmp_path / "h.csv"
+    history.write_text(content)
+    code = main(["simulate", str(scene), str(history), "-o", str(tmp_path / "o.csv"), "--contact", "finger"])
+    err = capsys.readouterr().err.strip()
+    assert code == 2
+    assert err.startswith("viscoadh simulate: error:") and message in err and "\n" not in err, err
+
+
+def test_ambiguous_contact_and_bad_model_are_errors(scene: Path, tmp_path: Path, capsys) -> None:
+    history = write_history(tmp_path / "h.csv", "time,depth", np.array([[0.0, 1e-6]]))
+    assert main(["simulate", str(scene), str(history), "-o", str(tmp_path / "o.csv")]) == 2
+    assert "--contact" in capsys.readouterr().err
+    assert main(["simulate", str(scene), str(history), "-o", str(tmp_path / "o.csv"), "--contact", "probe",
+                 "--model", "closed_form"]) == 2
+    assert "numerics.model" in capsys.readouterr().err
