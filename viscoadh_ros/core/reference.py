@@ -261,9 +261,16 @@ class Figure4Scales:
 
 def figure4_scales(radius: float, work_of_adhesion: float, element: CreepElement) -> Figure4Scales:
     """Figure-4 normalisation (physics notes section 4) for a sphere of radius ``R`` (m)."""
-    r = require_positive("radius", radius)
     w2 = work_of_adhesion_detaching(_work(work_of_adhesion), element)
-    e = element.relaxed_modulus_star
+    return jkr_scales(radius, element.relaxed_modulus_star, w2)
+
+
+def jkr_scales(radius: float, modulus_star: float, work_of_adhesion: float) -> Figure4Scales:
+    """JKR units of a sphere of radius ``R`` (m) on modulus ``E*`` (Pa) with work ``w`` (J/m^2):
+    ``F_c = 3/2 pi R w``, ``a_c``, ``d_c``; Figure 4 takes ``E_r*`` and ``w_eff2``."""
+    r = require_positive("radius", radius)
+    e = require_positive("modulus_star", modulus_star)
+    w2 = _work(work_of_adhesion)
     return Figure4Scales(
         force=1.5 * math.pi * r * w2,
         contact_radius=(9.0 * math.pi * w2 * r**2 / (8.0 * e)) ** (1.0 / 3.0),
