@@ -55,10 +55,19 @@ def test_file_follows_ros2_profile(tmp_path: Path) -> None:
         summary = reader.get_summary()
         assert summary is not None, "a closed recorder must leave a finished file"
         schemas = {s.name: s for s in summary.schemas.values()}
-        assert set(schemas) == {"geometry_msgs/msg/WrenchStamped", "std_msgs/msg/Float64", "geometry_msgs/msg/PointStamped"}
+        assert set(schemas) == {
+            "geometry_msgs/msg/WrenchStamped",
+            "std_msgs/msg/Float64",
+            "geometry_msgs/msg/PointStamped",
+        }
         assert all(s.encoding == "ros2msg" for s in schemas.values())
         text = schemas["geometry_msgs/msg/WrenchStamped"].data.decode()
-        for dep in ("std_msgs/Header", "builtin_interfaces/Time", "geometry_msgs/Wrench", "geometry_msgs/Vector3"):
+        for dep in (
+            "std_msgs/Header",
+            "builtin_interfaces/Time",
+            "geometry_msgs/Wrench",
+            "geometry_msgs/Vector3",
+        ):
             assert text.count(f"{'=' * 80}\nMSG: {dep}\n") == 1, f"dependency {dep} must appear once"
         for channel in summary.channels.values():
             assert channel.message_encoding == "cdr"
@@ -83,8 +92,12 @@ def test_rosbags_reads_file_and_folder(tmp_path: Path) -> None:
     for bag in (tmp_path / "run.mcap", tmp_path / "folder"):
         with AnyReader([bag]) as reader:
             conns = [c for c in reader.connections if c.topic == "/finger/wrench"]
-            values = [reader.deserialize(raw, c.msgtype).wrench.force.z for c, _, raw in reader.messages(conns)]
-            stamps = [reader.deserialize(raw, c.msgtype).header.stamp.sec for c, _, raw in reader.messages(conns)]
+            values = [
+                reader.deserialize(raw, c.msgtype).wrench.force.z for c, _, raw in reader.messages(conns)
+            ]
+            stamps = [
+                reader.deserialize(raw, c.msgtype).header.stamp.sec for c, _, raw in reader.messages(conns)
+            ]
         assert values == [0.5 * i for i in range(20)], f"rosbags values of {bag.name}"
         assert stamps == [100 + i for i in range(20)], f"rosbags stamps of {bag.name}"
 
@@ -146,8 +159,12 @@ def test_rotation(tmp_path: Path, kwargs: dict, n_files: int | None) -> None:
 
 
 def test_bad_settings_name_the_parameter(tmp_path: Path) -> None:
-    for kwargs, name in [({"chunk_size": 0}, "log.chunk_size"), ({"queue_size": -1}, "log.queue_size"),
-                         ({"max_bytes": -5}, "log.max_bytes"), ({"max_duration": float("nan")}, "log.max_duration")]:
+    for kwargs, name in [
+        ({"chunk_size": 0}, "log.chunk_size"),
+        ({"queue_size": -1}, "log.queue_size"),
+        ({"max_bytes": -5}, "log.max_bytes"),
+        ({"max_duration": float("nan")}, "log.max_duration"),
+    ]:
         with pytest.raises(ConfigError, match=name):
             McapRecorder(tmp_path / "x.mcap", **kwargs)
     assert not (tmp_path / "x.mcap").exists()
@@ -171,8 +188,12 @@ CHILD = textwrap.dedent(
 
 def test_sigkill_leaves_complete_chunks_readable(tmp_path: Path) -> None:
     path = tmp_path / "killed.mcap"
-    child = subprocess.Popen([sys.executable, "-c", CHILD, str(path)], stdout=subprocess.PIPE, text=True,
-                             env={**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)})
+    child = subprocess.Popen(
+        [sys.executable, "-c", CHILD, str(path)],
+        stdout=subprocess.PIPE,
+        text=True,
+        env={**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)},
+    )
     try:
         assert child.stdout.readline().strip() == "written", "child recorder did not start"
     finally:

@@ -24,8 +24,9 @@ def test_reference_branch_has_jkr_landmarks() -> None:
     np.testing.assert_allclose(radius[force.argmin()], a_c, rtol=1e-3, err_msg="pull-off radius a_c")
     np.testing.assert_allclose(f_c, 1.5 * math.pi * 0.01 * 0.1, rtol=1e-12, err_msg="F_c")
     # d_c against its definition in physics.md (Figure 4 normalisation).
-    np.testing.assert_allclose(d_c, (3 * math.pi**2 * 0.1**2 * 0.01 / (64 * 4e5**2)) ** (1 / 3), rtol=1e-12,
-                               err_msg="d_c")
+    np.testing.assert_allclose(
+        d_c, (3 * math.pi**2 * 0.1**2 * 0.01 / (64 * 4e5**2)) ** (1 / 3), rtol=1e-12, err_msg="d_c"
+    )
 
 
 @pytest.mark.parametrize("suffix", [".png", ".svg"])
@@ -33,8 +34,13 @@ def test_plot_from_csv(tmp_path: Path, suffix: str) -> None:
     a = np.linspace(0.0, 4e-4, 50)
     depth, force = REF.branch(REF.work_indentation, a)
     csv = tmp_path / "result.csv"
-    np.savetxt(csv, np.column_stack([np.arange(50) * 0.01, depth, force, a]), delimiter=",",
-               header="time,depth,force,contact_radius", comments="")
+    np.savetxt(
+        csv,
+        np.column_stack([np.arange(50) * 0.01, depth, force, a]),
+        delimiter=",",
+        header="time,depth,force,contact_radius",
+        comments="",
+    )
     fig = tmp_path / f"fig{suffix}"
     assert main(["plot", str(csv), "-o", str(fig)]) == 0
     assert fig.stat().st_size > 1000
@@ -49,12 +55,16 @@ def test_plot_loops_normalised_needs_reference(tmp_path: Path) -> None:
 
 @pytest.mark.parametrize(
     "content, args, expected",
-    [("a,b\n1,2\n3,4\n", [], "lacks the columns"),
-     ("depth,force,contact_radius\n1,2,3\n", [], "fewer than two rows"),
-     ("depth,force,contact_radius\n1,2,3\n2,3,4\n", ["-o", "fig.pdf"], "must be a .png or .svg")],
+    [
+        ("a,b\n1,2\n3,4\n", [], "lacks the columns"),
+        ("depth,force,contact_radius\n1,2,3\n", [], "fewer than two rows"),
+        ("depth,force,contact_radius\n1,2,3\n2,3,4\n", ["-o", "fig.pdf"], "must be a .png or .svg"),
+    ],
     ids=["columns", "rows", "format"],
 )
-def test_plot_bad_input(tmp_path: Path, capsys: pytest.CaptureFixture, content: str, args: list, expected: str) -> None:
+def test_plot_bad_input(
+    tmp_path: Path, capsys: pytest.CaptureFixture, content: str, args: list, expected: str
+) -> None:
     csv = tmp_path / "in.csv"
     csv.write_text(content)
     out = args[1] if args else "fig.png"

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 from geometry_msgs.msg import PointStamped, WrenchStamped
-from std_msgs.msg import Float64, String
+from std_msgs.msg import String
 
 from viscoadh_ros.cli.main import main
 from viscoadh_ros.io.mcap_log import McapRecorder
@@ -33,7 +33,11 @@ def _bag(path: Path, *, force: bool = True, late_force: bool = False, extra: boo
 
 CASES = {
     "missing topic": (lambda p: _bag(p), ["--depth-topic", "nope"], "topic 'nope' is not in"),
-    "unknown type": (lambda p: _bag(p, extra=True), ["--depth-topic", "note"], "has type 'std_msgs/msg/String'"),
+    "unknown type": (
+        lambda p: _bag(p, extra=True),
+        ["--depth-topic", "note"],
+        "has type 'std_msgs/msg/String'",
+    ),
     "ambiguous": (lambda p: _bag(p, extra=True), [], "several input (depth) topics"),
     "no force": (lambda p: _bag(p, force=False), [], "no measured force"),
     "empty time range": (lambda p: _bag(p, late_force=True), [], "empty time range"),
@@ -51,7 +55,9 @@ def _truncate(path: Path) -> Path:
 
 @pytest.mark.parametrize("verb", ["replay", "fit"])
 @pytest.mark.parametrize("case", sorted(CASES))
-def test_bad_recording_gives_one_line(case: str, verb: str, tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
+def test_bad_recording_gives_one_line(
+    case: str, verb: str, tmp_path: Path, capsys: pytest.CaptureFixture
+) -> None:
     make, extra_args, expected = CASES[case]
     bag = make(tmp_path / "in.mcap")
     out = tmp_path / ("out.mcap" if verb == "replay" else "out.yaml")

@@ -71,7 +71,9 @@ class Experiment:
     @property
     def duration(self) -> float:
         """Span of the record (inputs and measured force), s."""
-        last = self.input_ns[-1] if self.measured_ns.size == 0 else max(self.input_ns[-1], self.measured_ns[-1])
+        last = (
+            self.input_ns[-1] if self.measured_ns.size == 0 else max(self.input_ns[-1], self.measured_ns[-1])
+        )
         return (int(last) - self.t0_ns) * 1e-9
 
 
@@ -103,7 +105,9 @@ def _force_of(message: RecordedMessage) -> float:
     return float(message.msg.data)
 
 
-def _pick(bag: Bag, given: str | None, default: str | None, types: tuple[str, ...], what: str, flag: str) -> str | None:
+def _pick(
+    bag: Bag, given: str | None, default: str | None, types: tuple[str, ...], what: str, flag: str
+) -> str | None:
     """The topic named by the user, else ``default`` if recorded, else the only one of ``types``."""
     if given:
         topic = bag.resolve(given)
@@ -117,7 +121,9 @@ def _pick(bag: Bag, given: str | None, default: str | None, types: tuple[str, ..
         if len(candidates) != 1:
             if not candidates:
                 return None
-            raise InputError(f"several {what} topics in {str(bag.path)!r} ({candidates}); choose one with {flag}")
+            raise InputError(
+                f"several {what} topics in {str(bag.path)!r} ({candidates}); choose one with {flag}"
+            )
         topic = candidates[0]
     if bag.topics[topic] not in types:
         raise InputError(
@@ -141,15 +147,22 @@ def load_experiment(
     PoseStamped) and the only WrenchStamped topic. A Float64 topic is used only when named.
     Raises InputError naming what is missing, ambiguous or of the wrong type.
     """
-    inputs = _pick(bag, input_topic, f"{contact}/indentation" if contact else None,
-                   INPUT_TYPES, "input (depth)", "--depth-topic")
+    inputs = _pick(
+        bag,
+        input_topic,
+        f"{contact}/indentation" if contact else None,
+        INPUT_TYPES,
+        "input (depth)",
+        "--depth-topic",
+    )
     if inputs is None:
         raise InputError(
             f"no input topic in {str(bag.path)!r}: record IndentationCommand, PointStamped or "
             f"PoseStamped, or name a Float64 depth with --depth-topic (topics: {bag.topics})"
         )
-    forces = _pick(bag, force_topic, f"{contact}/wrench" if contact else None,
-                   FORCE_TYPES, "force", "--force-topic")
+    forces = _pick(
+        bag, force_topic, f"{contact}/wrench" if contact else None, FORCE_TYPES, "force", "--force-topic"
+    )
     if forces == inputs:
         raise InputError(f"the input and the force topic are both {inputs!r}")
     rows = [(_stamp_ns(m), m.order, *_input_of(m)) for m in bag.messages([inputs])]

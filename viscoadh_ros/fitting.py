@@ -95,7 +95,9 @@ def parameters_of(contact: ContactConfig) -> dict[str, float]:
     """Current parameter values of a contact."""
     material = contact.material
     values = {"G0": float(material.glass_shear_modulus)}
-    for k, (g, eta) in enumerate(zip(material.kelvin_shear_moduli, material.kelvin_viscosities), start=1):
+    for k, (g, eta) in enumerate(
+        zip(material.kelvin_shear_moduli, material.kelvin_viscosities, strict=True), start=1
+    ):
         values[f"G{k}"] = float(g)
         values[f"eta{k}"] = float(eta)
     values["work_of_adhesion"] = float(contact.adhesion.work_of_adhesion)
@@ -184,7 +186,7 @@ def fit(
 
     def model(theta: NDArray[np.float64], names: Sequence[str]) -> NDArray[np.float64]:
         trial = dict(values)
-        trial.update({n: float(math.exp(t)) for n, t in zip(names, theta)})
+        trial.update({n: float(math.exp(t)) for n, t in zip(names, theta, strict=True)})
         try:
             return run_model(with_parameters(contact, trial, kelvin), experiment).model_force[usable]
         except ValueError:
@@ -201,12 +203,12 @@ def fit(
             diff_step=1e-4,
             x_scale=1.0,
         )
-        values.update({n: float(math.exp(t)) for n, t in zip(stage1, first.x)})
+        values.update({n: float(math.exp(t)) for n, t in zip(stage1, first.x, strict=True)})
     x0 = np.log([values[n] for n in free])
     result = least_squares(lambda th: (model(th, free) - measured) / scale, x0, diff_step=1e-4, x_scale=1.0)
     if not result.success:
         raise FitError(f"the fit did not converge: {result.message}")
-    values.update({n: float(math.exp(t)) for n, t in zip(free, result.x)})
+    values.update({n: float(math.exp(t)) for n, t in zip(free, result.x, strict=True)})
     secant = np.column_stack(
         [
             (model(result.x + SECANT_STEP * e, free) - model(result.x - SECANT_STEP * e, free))
@@ -218,7 +220,7 @@ def fit(
     residual = result.fun * scale
     return FitResult(
         values=values,
-        uncertainty={n: values[n] * s for n, s in zip(free, sigma)},
+        uncertainty={n: values[n] * s for n, s in zip(free, sigma, strict=True)},
         free=tuple(free),
         rmse=float(np.sqrt(np.mean(residual**2))),
         max_error=float(np.max(np.abs(residual))),
@@ -257,7 +259,7 @@ def _uncertainty(
 ) -> NDArray[np.float64]:
     """Standard deviations of the log-parameters; FitError for unidentified ones."""
     norms = np.linalg.norm(jac, axis=0)
-    dead = [n for n, c in zip(free, norms) if not c > 1e-12 * max(float(np.max(norms)), 1e-300)]
+    dead = [n for n, c in zip(free, norms, strict=True) if not c > 1e-12 * max(float(np.max(norms)), 1e-300)]
     if dead:
         raise FitError(
             f"{', '.join(dead)} cannot be identified: the force does not depend on it in this record"
@@ -265,7 +267,7 @@ def _uncertainty(
     scaled = jac / norms
     _, singular, vt = np.linalg.svd(scaled, full_matrices=False)
     if singular[-1] <= 0 or singular[0] / singular[-1] > MAX_CONDITION:
-        involved = [n for n, v in zip(free, vt[-1]) if abs(v) > 0.3]
+        involved = [n for n, v in zip(free, vt[-1], strict=True) if abs(v) > 0.3]
         raise FitError(
             f"{', '.join(involved)} cannot be identified separately from this record (they only act "
             "together; a viscosity needs a change of rate or a hold); fix one of them"
@@ -274,7 +276,9 @@ def _uncertainty(
     s2 = float(fun @ fun) / dof
     cov = s2 * np.linalg.inv(jac.T @ jac)
     sigma = np.sqrt(np.clip(np.diag(cov), 0.0, None))
-    vague = [f"{n} (+-{100 * s:.0f}%)" for n, s in zip(free, sigma) if s > MAX_RELATIVE_UNCERTAINTY]
+    vague = [
+        f"{n} (+-{100 * s:.0f}%)" for n, s in zip(free, sigma, strict=True) if s > MAX_RELATIVE_UNCERTAINTY
+    ]
     if vague:
         raise FitError(
             f"{', '.join(vague)} not identified by this record (a viscosity needs a change of rate "

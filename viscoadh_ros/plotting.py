@@ -1,7 +1,7 @@
 """Force-depth and force-radius figures with the paper's quasistatic JKR branches (matplotlib Agg).
 
 Reference branches for a sphere (paraboloid) of radius R (physics.md section 4): JKR with the
-relaxed modulus ``E_r* = 4 G_inf`` (``1/G_inf = 1/G0 + sum_k 1/G_k``), for indentation with
+relaxed modulus ``E_r* = 2 G_inf/(1 - nu)`` (``1/G_inf = 1/G0 + sum_k 1/G_k``), for indentation with
 ``w_eff1 = w G_inf/G0`` and for detachment with ``w_eff2 = w G0/G_inf`` (for one Kelvin element
 these are ``w G1/(G0+G1)`` and ``w (G0+G1)/G1``). Normalised units are the paper's Figure 4:
 ``F/F_c``, ``a/a_c``, ``d/d_c`` with ``w_eff2`` and ``E_r*``.
@@ -9,14 +9,17 @@ these are ``w G1/(G0+G1)`` and ``w (G0+G1)/G1``). Normalised units are the paper
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
 
 from viscoadh_ros.core.errors import InputError
+
+if TYPE_CHECKING:
+    from viscoadh_ros.core.config import ContactConfig
 
 
 @dataclass(frozen=True)
@@ -39,17 +42,25 @@ class JkrReference:
     work_detachment: float
 
     @classmethod
-    def from_contact(cls, contact) -> JkrReference | None:
+    def from_contact(cls, contact: ContactConfig) -> JkrReference | None:
         """The reference of a sphere contact with adhesion; None for other indenters."""
         if contact.indenter.shape != "sphere" or not contact.adhesion.work_of_adhesion > 0:
             return None
-        material = contact.material
-        g0 = float(material.glass_shear_modulus)
-        g_inf = 1.0 / (1.0 / g0 + sum(1.0 / float(g) for g in material.kelvin_shear_moduli))
-        w = float(contact.adhesion.work_of_adhesion)
-        return cls(float(contact.indenter.radius), 4.0 * g_inf, w * g_inf / g0, w * g0 / g_inf)
+        from viscoadh_ros.core.criterion import work_of_adhesion_detaching, work_of_adhesion_indenting
+        from viscoadh_ros.core.rheology import CreepElement
 
-    def branch(self, work: float, radius: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        element = CreepElement.from_config(contact.material)
+        w = float(contact.adhesion.work_of_adhesion)
+        return cls(
+            float(contact.indenter.radius),
+            element.relaxed_modulus_star,
+            work_of_adhesion_indenting(w, element),
+            work_of_adhesion_detaching(w, element),
+        )
+
+    def branch(
+        self, work: float, radius: NDArray[np.float64]
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """JKR (depth, force) along contact radii ``radius`` for work of adhesion ``work``."""
         from viscoadh_ros.core import reference
 
@@ -59,11 +70,10 @@ class JkrReference:
     @property
     def scales(self) -> tuple[float, float, float]:
         """(F_c in N, a_c in m, d_c in m) of the paper's Figure 4."""
-        r, e, w2 = self.radius, self.relaxed_modulus, self.work_detachment
-        force = 1.5 * math.pi * r * w2
-        radius = (9.0 * math.pi * w2 * r**2 / (8.0 * e)) ** (1.0 / 3.0)
-        depth = (3.0 * math.pi**2 * w2**2 * r / (64.0 * e**2)) ** (1.0 / 3.0)
-        return force, radius, depth
+        from viscoadh_ros.core import reference
+
+        units = reference.jkr_scales(self.radius, self.relaxed_modulus, self.work_detachment)
+        return units.force, units.contact_radius, units.depth
 
 
 def plot_loops(
@@ -97,8 +107,10 @@ def plot_loops(
     if reference is not None:
         a_max = max(float(np.max(c.contact_radius)) for c in curves) * 1.15 or 1.0
         radius = np.linspace(0.0, a_max, 400)
-        for work, style, name in ((reference.work_indentation, "--", "JKR indentation, w_eff1"),
-                                  (reference.work_detachment, "-.", "JKR detachment, w_eff2")):
+        for work, style, name in (
+            (reference.work_indentation, "--", "JKR indentation, w_eff1"),
+            (reference.work_detachment, "-.", "JKR detachment, w_eff2"),
+        ):
             depth, force = reference.branch(work, radius)
             ax_d.plot(depth * d_k, force * f_k, style, color="0.35", lw=1.2, label=name)
             ax_a.plot(radius * a_k, force * f_k, style, color="0.35", lw=1.2, label=name)

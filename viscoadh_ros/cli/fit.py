@@ -29,10 +29,18 @@ def _kelvin(text: str) -> int:
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_input_arguments(parser)
-    parser.add_argument("--free", default=None,
-                        help="comma-separated parameters to fit (default: G0,G1..GK,eta1..etaK,work_of_adhesion)")
-    parser.add_argument("--kelvin", type=_kelvin, default=1, metavar="K",
-                        help="number of Kelvin elements of the rheology (default 1: standard solid)")
+    parser.add_argument(
+        "--free",
+        default=None,
+        help="comma-separated parameters to fit (default: G0,G1..GK,eta1..etaK,work_of_adhesion)",
+    )
+    parser.add_argument(
+        "--kelvin",
+        type=_kelvin,
+        default=1,
+        metavar="K",
+        help="number of Kelvin elements of the rheology (default 1: standard solid)",
+    )
     parser.add_argument("-o", "--output", type=Path, required=True, help="scene YAML to write")
 
 

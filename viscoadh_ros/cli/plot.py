@@ -20,12 +20,20 @@ COLUMNS = ("depth", "force", "contact_radius")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("input", type=Path, help="result .csv, or .mcap file / rosbag2 folder with ContactState")
+    parser.add_argument(
+        "input", type=Path, help="result .csv, or .mcap file / rosbag2 folder with ContactState"
+    )
     parser.add_argument("-o", "--output", type=Path, required=True, help="figure file, .png or .svg")
-    parser.add_argument("--scene", type=Path, help="scene YAML for the reference branches (default: stored in the MCAP)")
+    parser.add_argument(
+        "--scene", type=Path, help="scene YAML for the reference branches (default: stored in the MCAP)"
+    )
     parser.add_argument("--contact", help="contact id (default: the only one)")
-    parser.add_argument("--normalised", action="store_true", help="the paper's Figure-4 units F/F_c, a/a_c, d/d_c")
-    parser.add_argument("--recover", action="store_true", help="read unfinished MCAP files up to their last complete chunk")
+    parser.add_argument(
+        "--normalised", action="store_true", help="the paper's Figure-4 units F/F_c, a/a_c, d/d_c"
+    )
+    parser.add_argument(
+        "--recover", action="store_true", help="read unfinished MCAP files up to their last complete chunk"
+    )
 
 
 def _csv_curves(path: Path) -> list[Curve]:
@@ -50,7 +58,9 @@ def _mcap_curves(args: argparse.Namespace):
     if args.contact:
         topics = [t for t in topics if t.strip("/").split("/")[-2:-1] == [args.contact]]
     if not topics:
-        raise InputError(f"no ContactState topic{' of ' + args.contact if args.contact else ''} in {str(args.input)!r}")
+        raise InputError(
+            f"no ContactState topic{' of ' + args.contact if args.contact else ''} in {str(args.input)!r}"
+        )
     curves = []
     for topic in topics:
         rows = np.array([(m.msg.depth, m.msg.force, m.msg.contact_radius) for m in bag.messages([topic])])

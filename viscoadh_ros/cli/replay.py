@@ -33,14 +33,24 @@ def add_input_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("bag", type=Path, help="an .mcap file or a rosbag2 folder")
     parser.add_argument("--scene", type=Path, help="scene YAML (default: the one stored in BAG by the node)")
     parser.add_argument("--contact", help="contact id in the scene (default: the only one)")
-    parser.add_argument("--depth-topic", help="input topic: IndentationCommand, Float64 depth (m), "
-                        "or PointStamped/PoseStamped whose z is the depth (m)")
-    parser.add_argument("--force-topic", help="measured force: WrenchStamped (force.z, N) or Float64 (N), "
-                        "> 0 compressive")
-    parser.add_argument("--flip-force", action="store_true",
-                        help="negate the measured force (load cells that read tension positive)")
-    parser.add_argument("--recover", action="store_true",
-                        help="read unfinished (truncated) files up to their last complete chunk")
+    parser.add_argument(
+        "--depth-topic",
+        help="input topic: IndentationCommand, Float64 depth (m), "
+        "or PointStamped/PoseStamped whose z is the depth (m)",
+    )
+    parser.add_argument(
+        "--force-topic", help="measured force: WrenchStamped (force.z, N) or Float64 (N), > 0 compressive"
+    )
+    parser.add_argument(
+        "--flip-force",
+        action="store_true",
+        help="negate the measured force (load cells that read tension positive)",
+    )
+    parser.add_argument(
+        "--recover",
+        action="store_true",
+        help="read unfinished (truncated) files up to their last complete chunk",
+    )
 
 
 def open_experiment(args: argparse.Namespace) -> tuple[Bag, SceneConfig, Experiment]:
@@ -94,15 +104,21 @@ def main(args: argparse.Namespace) -> int:
     summary = compare(experiment, run)
     _write_output(args.output, scene, contact.id, experiment, run)
 
-    result = {"bag": str(args.bag), "contact": contact.id, "input_topic": experiment.input_topic,
-              "force_topic": experiment.force_topic, "output": str(args.output), **summary.as_dict()}
-    pull = lambda f: "none (never tensile)" if f is None else f"{f:.6g} N"
+    result = {
+        "bag": str(args.bag),
+        "contact": contact.id,
+        "input_topic": experiment.input_topic,
+        "force_topic": experiment.force_topic,
+        "output": str(args.output),
+        **summary.as_dict(),
+    }
     print(
         f"replayed {experiment.input_ns.size} inputs of {contact.id} over {experiment.duration:.3f} s "
         f"at {summary.speed:.3g}x real time\n"
         f"force error vs {experiment.force_topic}: RMSE {summary.rmse:.6g} N, max {summary.max_error:.6g} N "
         f"({summary.samples} samples)\n"
-        f"pull-off force: measured {pull(summary.measured_pull_off)}, model {pull(summary.model_pull_off)}\n"
+        f"pull-off force: measured {_pull_off_text(summary.measured_pull_off)}, "
+        f"model {_pull_off_text(summary.model_pull_off)}\n"
         f"wrote {args.output}"
     )
     if args.json is not None:
@@ -110,7 +126,13 @@ def main(args: argparse.Namespace) -> int:
     return 0
 
 
-def _write_output(path: Path, scene: SceneConfig, contact_id: str, experiment: Experiment, run: ModelRun) -> None:
+def _pull_off_text(force: float | None) -> str:
+    return "none (never tensile)" if force is None else f"{force:.6g} N"
+
+
+def _write_output(
+    path: Path, scene: SceneConfig, contact_id: str, experiment: Experiment, run: ModelRun
+) -> None:
     """The model's states and wrenches on the input stamps, with the scene, as MCAP."""
     from viscoadh_ros.io.mcap_log import McapRecorder
     from viscoadh_ros.ros import conversions
@@ -120,13 +142,20 @@ def _write_output(path: Path, scene: SceneConfig, contact_id: str, experiment: E
         path.unlink()
     # Offline, nothing may be dropped: a queue that holds every message.
     recorder = McapRecorder(path, scene=scene.to_dict(), queue_size=2 * len(run.input_outputs) + 16)
-    received = 0
-    for stamp, output in zip(experiment.input_ns.tolist(), run.input_outputs):
-        received += 1
-        state = conversions.contact_state(output, stamp_ns=stamp, frame_id=frame, model=run.model,
-                                          commands_received=received, commands_rejected=0)
+    inputs = zip(experiment.input_ns.tolist(), run.input_outputs, strict=True)
+    for received, (stamp, output) in enumerate(inputs, start=1):
+        state = conversions.contact_state(
+            output,
+            stamp_ns=stamp,
+            frame_id=frame,
+            model=run.model,
+            commands_received=received,
+            commands_rejected=0,
+        )
         recorder.record(f"/{contact_id}/state", state, stamp)
-        recorder.record(f"/{contact_id}/wrench", conversions.wrench(output, stamp_ns=stamp, frame_id=frame), stamp)
+        recorder.record(
+            f"/{contact_id}/wrench", conversions.wrench(output, stamp_ns=stamp, frame_id=frame), stamp
+        )
     recorder.close()
     if recorder.error is not None or recorder.dropped:
         raise RuntimeError(f"writing {path} failed: {recorder.error!r}, {recorder.dropped} messages dropped")

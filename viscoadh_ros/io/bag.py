@@ -63,7 +63,9 @@ def _bag_files(path: Path) -> list[Path]:
         files = [path / name for name in names]
         missing = [str(f) for f in files if not f.is_file()]
         if missing:
-            raise InputError(f"bag folder {str(path)!r}: files listed in metadata.yaml are missing: {missing}")
+            raise InputError(
+                f"bag folder {str(path)!r}: files listed in metadata.yaml are missing: {missing}"
+            )
     else:
         # A folder whose recorder was killed has no metadata.yaml yet: take its files in order.
         files = sorted(path.glob("*.mcap"), key=lambda f: (len(f.name), f.name))
@@ -172,7 +174,9 @@ class Bag:
             try:
                 msg = deserialize_message(data, cls)
             except Exception as exc:  # noqa: BLE001 - rclpy raises plain exceptions on bad CDR
-                raise InputError(f"topic {name!r}: message at {log_time} ns does not decode ({exc})") from None
+                raise InputError(
+                    f"topic {name!r}: message at {log_time} ns does not decode ({exc})"
+                ) from None
             yield RecordedMessage(name, self._topics[name].type_name, log_time, msg, order)
 
     def scene(self) -> dict[str, Any] | None:

@@ -121,7 +121,10 @@ class _File:
             self.channels[item.topic] = channel
             self.topic_types[item.topic] = item.type_name
         self.writer.add_message(
-            channel, log_time=item.stamp_ns, publish_time=item.stamp_ns, data=item.data,
+            channel,
+            log_time=item.stamp_ns,
+            publish_time=item.stamp_ns,
+            data=item.data,
             sequence=self.counts[item.topic],
         )
         self.counts[item.topic] += 1
@@ -178,7 +181,9 @@ class McapRecorder:
             raise ConfigError(f"log.max_bytes must be an integer >= 0 (got {max_bytes!r})")
         if not max_duration >= 0.0 or max_duration == float("inf"):
             raise ConfigError(f"log.max_duration must be finite and >= 0 s (got {max_duration!r})")
-        path = Path(path) if str(path) else Path(datetime.datetime.now().strftime("viscoadh_%Y_%m_%d-%H_%M_%S"))
+        path = (
+            Path(path) if str(path) else Path(datetime.datetime.now().strftime("viscoadh_%Y_%m_%d-%H_%M_%S"))
+        )
         self._folder = None if path.suffix == ".mcap" else path
         self._stem = self._folder / self._folder.name if self._folder is not None else path.with_suffix("")
         self._rotating = max_bytes > 0 or max_duration > 0.0
@@ -200,7 +205,9 @@ class McapRecorder:
         # in the writer thread.
         try:
             self._stem.parent.mkdir(parents=True, exist_ok=True)
-            self._file: _File | None = _File(self._next_path(), chunk_size=chunk_size, metadata=self._metadata)
+            self._file: _File | None = _File(
+                self._next_path(), chunk_size=chunk_size, metadata=self._metadata
+            )
         except OSError as exc:
             raise ConfigError(f"log.path {str(path)!r} cannot be written ({exc.strerror or exc})") from None
         self._types: dict[type, str] = {}

@@ -23,8 +23,21 @@ from viscoadh_ros.core.errors import InputError
 #: Built-in field types of the ROS 2 interface language (no dependency).
 _PRIMITIVES = frozenset(
     {
-        "bool", "byte", "char", "float32", "float64", "int8", "uint8", "int16", "uint16",
-        "int32", "uint32", "int64", "uint64", "string", "wstring",
+        "bool",
+        "byte",
+        "char",
+        "float32",
+        "float64",
+        "int8",
+        "uint8",
+        "int16",
+        "uint16",
+        "int32",
+        "uint32",
+        "int64",
+        "uint64",
+        "string",
+        "wstring",
     }
 )
 _SEPARATOR = "=" * 80
