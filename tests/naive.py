@@ -26,7 +26,9 @@ def interior_count(a: float, dx: float, n: int) -> int:
     return max(1, int(np.count_nonzero(centres < a)))
 
 
-def chain_step(l0: np.ndarray, u0: float, u1: float, dt: float, row: _kernels.Row, in_contact: bool) -> np.ndarray:
+def chain_step(
+    l0: np.ndarray, u0: float, u1: float, dt: float, row: _kernels.Row, in_contact: bool
+) -> np.ndarray:
     """Exact Kelvin chain update by the matrix exponential of the augmented linear system
     ``d/dt [l, u, s] = [[A, b, 0], [0, 0, 1], [0, 0, 0]] [l, u, s]`` (u linear, slope s)."""
     k = row.e_kelvin.size
@@ -58,8 +60,9 @@ def g_at(row: _kernels.Row, x: np.ndarray) -> np.ndarray:
     return np.interp(x, fine, row.gf)
 
 
-def side_values(row: _kernels.Row, x: np.ndarray, values: np.ndarray, lo: int, hi: int, coef: float,
-                depth: float) -> np.ndarray:
+def side_values(
+    row: _kernels.Row, x: np.ndarray, values: np.ndarray, lo: int, hi: int, coef: float, depth: float
+) -> np.ndarray:
     """`_kernels._w_side` vectorised: interpolate ``values - coef u`` over elements lo..hi,
     linear extrapolation towards the edge, hold at the centre and the far end."""
     x = np.asarray(x, dtype=np.float64)
@@ -127,7 +130,9 @@ def locate_edge(row: _kernels.Row, radius: float, depth: float, points: int = 40
     x = x[x <= reach]
     n = row.elements
     if radius <= 0.0:
-        touching = np.flatnonzero(depth - g_at(row, x) - side_values(row, x, row.wsum, 0, n - 1, 0.0, depth) >= 0.0)
+        touching = np.flatnonzero(
+            depth - g_at(row, x) - side_values(row, x, row.wsum, 0, n - 1, 0.0, depth) >= 0.0
+        )
         if touching.size == 0:
             return 0.0
         start = x[touching[0]]
@@ -144,7 +149,9 @@ def locate_edge(row: _kernels.Row, radius: float, depth: float, points: int = 40
             return 0.0
         j = below[-1]
         x_hi = x[j + 1] if x[j + 1] < radius else radius
-        return float(x[j] + (x_hi - x[j]) * h[j] / (h[j] - gap(row, np.array([x_hi]), depth, radius, True)[0]))
+        return float(
+            x[j] + (x_hi - x[j]) * h[j] / (h[j] - gap(row, np.array([x_hi]), depth, radius, True)[0])
+        )
     return radius
 
 

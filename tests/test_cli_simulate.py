@@ -51,14 +51,33 @@ def test_depth_history_gives_hertz(scene: Path, tmp_path: Path, capsys) -> None:
     depth = np.linspace(0.0, 1e-5, 21)
     history = write_history(tmp_path / "h.csv", "time,depth", np.c_[time, depth])
     out = tmp_path / "out.csv"
-    assert main(["simulate", str(scene), str(history), "-o", str(out), "--contact", "finger",
-                 "--model", "time_stepped"]) == 0
+    assert (
+        main(
+            [
+                "simulate",
+                str(scene),
+                str(history),
+                "-o",
+                str(out),
+                "--contact",
+                "finger",
+                "--model",
+                "time_stepped",
+            ]
+        )
+        == 0
+    )
     assert "time_stepped" in capsys.readouterr().out
     result = read_result(out)
     assert result["time"].size == 21
     np.testing.assert_allclose(result["depth"], depth, rtol=0, atol=0, err_msg="depth column")
-    np.testing.assert_allclose(result["force"], reference.hertz_force(depth, 1e-3, 4e6), rtol=5e-3, atol=1e-12,
-                               err_msg="Hertz through the CLI")
+    np.testing.assert_allclose(
+        result["force"],
+        reference.hertz_force(depth, 1e-3, 4e6),
+        rtol=5e-3,
+        atol=1e-12,
+        err_msg="Hertz through the CLI",
+    )
     assert set(np.unique(result["phase"])) <= {0.0, 1.0}
 
 
@@ -67,22 +86,31 @@ def test_force_history_and_preset(scene: Path, tmp_path: Path) -> None:
     force = np.linspace(0.0, 1e-3, 11)
     history = write_history(tmp_path / "h.csv", "time,force", np.c_[time, force])
     out = tmp_path / "out.csv"
-    assert main(["simulate", str(scene), str(history), "-o", str(out), "--contact", "probe", "--preset", "fast"]) == 0
+    assert (
+        main(["simulate", str(scene), str(history), "-o", str(out), "--contact", "probe", "--preset", "fast"])
+        == 0
+    )
     result = read_result(out)
     in_contact = result["contact_radius"] > 0.0
-    np.testing.assert_allclose(result["force"][in_contact], force[in_contact], rtol=1e-3, atol=1e-9,
-                               err_msg="force tracking")
+    np.testing.assert_allclose(
+        result["force"][in_contact], force[in_contact], rtol=1e-3, atol=1e-9, err_msg="force tracking"
+    )
 
 
-@pytest.mark.parametrize(("content", "message"), [
-    ("time,height\n0,1\n", "header must be"),
-    ("time,depth\n0,1e-6\n0.1,abc\n", ":3: column 'depth' is not a number"),
-    ("time,depth\n0,1e-6\n0.1,nan\n", ":3: column 'depth' must be finite"),
-    ("time,depth\n0,1e-6\n0,2e-6\n", ":3: column 'time' must increase"),
-    ("time,depth\n0,1e-6,3\n", ":2: expected 2 columns"),
-    ("time,depth\n", "no samples"),
-])
-def test_bad_history_is_one_line_error(scene: Path, tmp_path: Path, capsys, content: str, message: str) -> None:
+@pytest.mark.parametrize(
+    ("content", "message"),
+    [
+        ("time,height\n0,1\n", "header must be"),
+        ("time,depth\n0,1e-6\n0.1,abc\n", ":3: column 'depth' is not a number"),
+        ("time,depth\n0,1e-6\n0.1,nan\n", ":3: column 'depth' must be finite"),
+        ("time,depth\n0,1e-6\n0,2e-6\n", ":3: column 'time' must increase"),
+        ("time,depth\n0,1e-6,3\n", ":2: expected 2 columns"),
+        ("time,depth\n", "no samples"),
+    ],
+)
+def test_bad_history_is_one_line_error(
+    scene: Path, tmp_path: Path, capsys, content: str, message: str
+) -> None:
     history = tmp_path / "h.csv"
     history.write_text(content)
     code = main(["simulate", str(scene), str(history), "-o", str(tmp_path / "o.csv"), "--contact", "finger"])
@@ -95,6 +123,20 @@ def test_ambiguous_contact_and_bad_model_are_errors(scene: Path, tmp_path: Path,
     history = write_history(tmp_path / "h.csv", "time,depth", np.array([[0.0, 1e-6]]))
     assert main(["simulate", str(scene), str(history), "-o", str(tmp_path / "o.csv")]) == 2
     assert "--contact" in capsys.readouterr().err
-    assert main(["simulate", str(scene), str(history), "-o", str(tmp_path / "o.csv"), "--contact", "probe",
-                 "--model", "closed_form"]) == 2
+    assert (
+        main(
+            [
+                "simulate",
+                str(scene),
+                str(history),
+                "-o",
+                str(tmp_path / "o.csv"),
+                "--contact",
+                "probe",
+                "--model",
+                "closed_form",
+            ]
+        )
+        == 2
+    )
     assert "numerics.model" in capsys.readouterr().err

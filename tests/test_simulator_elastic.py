@@ -23,9 +23,17 @@ def make_contact(indenter: dict, *, work: float = 0.0, model: str = "auto", kelv
     material = {"glass_shear_modulus": G0}
     if kelvin:
         material.update(kelvin_shear_moduli=list(kelvin), kelvin_viscosities=list(viscosities))
-    scene = SceneConfig.from_dict({"contacts": ["c"], "c": {
-        "indenter": indenter, "material": material, "adhesion": {"work_of_adhesion": work},
-        "numerics": {"model": model}}})
+    scene = SceneConfig.from_dict(
+        {
+            "contacts": ["c"],
+            "c": {
+                "indenter": indenter,
+                "material": material,
+                "adhesion": {"work_of_adhesion": work},
+                "numerics": {"model": model},
+            },
+        }
+    )
     return scene.contact("c")
 
 
@@ -41,8 +49,12 @@ def test_hertz_sphere(model: str) -> None:
     assert sim.model == model
     force = np.array([o.force for o in outputs])
     radius = np.array([o.contact_radius for o in outputs])
-    np.testing.assert_allclose(force, reference.hertz_force(depth, R, E0), rtol=5e-3, err_msg=f"Hertz force {model}")
-    np.testing.assert_allclose(radius, reference.hertz_radius(depth, R), rtol=5e-3, err_msg=f"Hertz radius {model}")
+    np.testing.assert_allclose(
+        force, reference.hertz_force(depth, R, E0), rtol=5e-3, err_msg=f"Hertz force {model}"
+    )
+    np.testing.assert_allclose(
+        radius, reference.hertz_radius(depth, R), rtol=5e-3, err_msg=f"Hertz radius {model}"
+    )
     assert all(o.phase == Phase.INDENTING for o in outputs), model
 
 
@@ -52,8 +64,12 @@ def test_sneddon_cone(model: str) -> None:
     depth = np.linspace(0.0, 2e-6, 41)[1:]
     _, outputs = run_depth(make_contact({"shape": "cone", "half_angle": half_angle}, model=model), depth)
     force = np.array([o.force for o in outputs])
-    np.testing.assert_allclose(force, reference.sneddon_cone_force(depth, half_angle, E0), rtol=5e-3,
-                               err_msg=f"Sneddon force {model}")
+    np.testing.assert_allclose(
+        force,
+        reference.sneddon_cone_force(depth, half_angle, E0),
+        rtol=5e-3,
+        err_msg=f"Sneddon force {model}",
+    )
 
 
 @pytest.mark.parametrize("model", MODELS)
@@ -83,17 +99,29 @@ def test_jkr_sphere_approach_and_retraction(model: str) -> None:
     turn = int(np.argmax(depth))
     approach, retraction = outputs[:turn], outputs[turn:]
     # Approach: no contact until the indenter touches (d >= 0), then on the JKR curve.
-    assert all(o.contact_radius == 0.0 for o in approach if o.depth < 0.0), f"{model}: contact before touching"
+    assert all(o.contact_radius == 0.0 for o in approach if o.depth < 0.0), (
+        f"{model}: contact before touching"
+    )
     fold = reference.jkr_pull_off_displacement_control(R, E0, work)
     for branch, name in ((approach, "approach"), (retraction, "retraction")):
         for o in branch:
             if o.contact_radius == 0.0:
                 continue
             case = f"{model} {name} d={o.depth:.4g}"
-            np.testing.assert_allclose(o.force, reference.jkr_force(o.contact_radius, R, E0, work), rtol=0,
-                                       atol=1e-2 * peak, err_msg=case)
-            np.testing.assert_allclose(o.depth, reference.jkr_depth(o.contact_radius, R, E0, work), rtol=0,
-                                       atol=1e-3 * abs(fold.depth), err_msg=case)
+            np.testing.assert_allclose(
+                o.force,
+                reference.jkr_force(o.contact_radius, R, E0, work),
+                rtol=0,
+                atol=1e-2 * peak,
+                err_msg=case,
+            )
+            np.testing.assert_allclose(
+                o.depth,
+                reference.jkr_depth(o.contact_radius, R, E0, work),
+                rtol=0,
+                atol=1e-3 * abs(fold.depth),
+                err_msg=case,
+            )
     # Retraction holds contact below zero depth down to the fold, then lets go.
     in_contact = [o.depth for o in retraction if o.contact_radius > 0.0]
     assert min(in_contact) < 0.9 * fold.depth, f"{model}: let go before the fold"
@@ -106,12 +134,15 @@ def test_jkr_sphere_approach_and_retraction(model: str) -> None:
 def test_jkr_last_stable_point_under_displacement_control(model: str) -> None:
     work = 0.05
     fold = reference.jkr_pull_off_displacement_control(R, E0, work)
-    depth = np.concatenate([[2.0 * abs(fold.depth)], np.linspace(0.999 * fold.depth, 1.001 * fold.depth, 401)])
+    depth = np.concatenate(
+        [[2.0 * abs(fold.depth)], np.linspace(0.999 * fold.depth, 1.001 * fold.depth, 401)]
+    )
     _, outputs = run_depth(make_contact({"shape": "sphere", "radius": R}, work=work, model=model), depth)
     last = [o for o in outputs if o.contact_radius > 0.0][-1]
     assert outputs[-1].contact_radius == 0.0, model
-    np.testing.assert_allclose(last.force, -(5.0 / 6.0) * math.pi * R * work, rtol=1e-2,
-                               err_msg=f"{model}: -(5/6) pi R w point")
+    np.testing.assert_allclose(
+        last.force, -(5.0 / 6.0) * math.pi * R * work, rtol=1e-2, err_msg=f"{model}: -(5/6) pi R w point"
+    )
 
 
 @pytest.mark.parametrize("model", MODELS)
@@ -120,12 +151,18 @@ def test_jkr_pull_off_under_force_control(model: str) -> None:
     pull_off = reference.jkr_pull_off_force_control(R, E0, work).force
     sim = ContactSimulator(make_contact({"shape": "sphere", "radius": R}, work=work, model=model))
     sim.step(1e-3, depth=2.0 * abs(reference.jkr_pull_off_displacement_control(R, E0, work).depth))
-    targets = np.concatenate([np.linspace(sim.output.force, 0.9 * pull_off, 20),
-                              np.linspace(0.9 * pull_off, 1.05 * pull_off, 301)[1:]])
+    targets = np.concatenate(
+        [
+            np.linspace(sim.output.force, 0.9 * pull_off, 20),
+            np.linspace(0.9 * pull_off, 1.05 * pull_off, 301)[1:],
+        ]
+    )
     outputs = [sim.step(2e-3 + i * 1e-3, force=float(f)) for i, f in enumerate(targets)]
     first_unstable = next(i for i, o in enumerate(outputs) if o.unstable)
     stable = outputs[first_unstable - 1]
-    np.testing.assert_allclose(stable.force, targets[first_unstable - 1], rtol=1e-5, err_msg=f"{model}: tracking")
+    np.testing.assert_allclose(
+        stable.force, targets[first_unstable - 1], rtol=1e-5, err_msg=f"{model}: tracking"
+    )
     np.testing.assert_allclose(stable.force, pull_off, rtol=5e-3, err_msg=f"{model}: -(3/2) pi R w")
     assert outputs[first_unstable].contact_radius == 0.0, f"{model}: still in contact after pull-off"
     assert all(math.isfinite(o.depth) and math.isfinite(o.force) for o in outputs), model
@@ -138,7 +175,9 @@ def test_kendall_flat_punch_pull_off(model: str) -> None:
     d_off = expected / reference.flat_punch_stiffness(R, E0)
     depth = np.concatenate([[1e-7], np.linspace(0.0, 1.2 * d_off, 241)])
     _, outputs = run_depth(make_contact({"shape": "flat_punch", "radius": R}, work=work, model=model), depth)
-    np.testing.assert_allclose(min(o.force for o in outputs), expected, rtol=1e-2, err_msg=f"{model}: Kendall")
+    np.testing.assert_allclose(
+        min(o.force for o in outputs), expected, rtol=1e-2, err_msg=f"{model}: Kendall"
+    )
     assert outputs[-1].contact_radius == 0.0, model
 
 

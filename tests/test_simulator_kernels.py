@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 
+import naive
 import numpy as np
 import pytest
 
@@ -11,20 +12,27 @@ from viscoadh_ros.core import _kernels
 from viscoadh_ros.core.config import SceneConfig
 from viscoadh_ros.core.simulator import ContactSimulator
 
-import naive
 
-
-def make_contact(*, shape="sphere", kelvin=(), viscosities=(), work=0.0, elements=0, model="time_stepped",
-                 **indenter):
+def make_contact(
+    *, shape="sphere", kelvin=(), viscosities=(), work=0.0, elements=0, model="time_stepped", **indenter
+):
     """One contact through the scene loader (radius 1 mm sphere unless told otherwise)."""
     indenter = {"shape": shape, **({"radius": 1e-3} if shape in ("sphere", "flat_punch") else {}), **indenter}
     material = {"glass_shear_modulus": 1e6}
     if kelvin:
         material.update(kelvin_shear_moduli=list(kelvin), kelvin_viscosities=list(viscosities))
     numerics = {"model": model, **({"elements": elements} if elements else {})}
-    scene = SceneConfig.from_dict({"contacts": ["c"], "c": {
-        "indenter": indenter, "material": material, "adhesion": {"work_of_adhesion": work},
-        "numerics": numerics}})
+    scene = SceneConfig.from_dict(
+        {
+            "contacts": ["c"],
+            "c": {
+                "indenter": indenter,
+                "material": material,
+                "adhesion": {"work_of_adhesion": work},
+                "numerics": numerics,
+            },
+        }
+    )
     return scene.contact("c")
 
 
@@ -75,29 +83,48 @@ def test_force_energy_and_gap_match_dense_quadrature(chain: str, radius: float) 
     case = f"{chain} a={radius}"
     # The kernel takes int g exactly at the fine points, the reference integrates the
     # linear interpolant of g: they differ at O(fine spacing^2).
-    np.testing.assert_allclose(_kernels.force(row, radius, depth), naive.force(row, radius, depth),
-                               rtol=2e-5, atol=1e-12, err_msg=case)
+    np.testing.assert_allclose(
+        _kernels.force(row, radius, depth),
+        naive.force(row, radius, depth),
+        rtol=2e-5,
+        atol=1e-12,
+        err_msg=case,
+    )
     # The kernel integrates the (piecewise quadratic) energy density by trapezoids on the fine
     # grid (32 points per element); random memory is rough, so allow that quadrature error.
-    np.testing.assert_allclose(_kernels.stored_energy(row, radius, depth), naive.stored_energy(row, radius, depth),
-                               rtol=1e-3, atol=1e-22, err_msg=case)
+    np.testing.assert_allclose(
+        _kernels.stored_energy(row, radius, depth),
+        naive.stored_energy(row, radius, depth),
+        rtol=1e-3,
+        atol=1e-22,
+        err_msg=case,
+    )
     for x in (1e-6, 0.5 * radius, radius, 1.5e-4):
         for interior in (True, False):
             np.testing.assert_allclose(
                 _kernels.criterion_gap(row, x, depth, radius, interior=interior),
-                naive.gap(row, np.array([x]), depth, radius, interior)[0], rtol=1e-9, atol=1e-15,
-                err_msg=f"{case} x={x} interior={interior}")
+                naive.gap(row, np.array([x]), depth, radius, interior)[0],
+                rtol=1e-9,
+                atol=1e-15,
+                err_msg=f"{case} x={x} interior={interior}",
+            )
 
 
 @pytest.mark.parametrize("chain", list(CHAINS))
 @pytest.mark.parametrize(("radius", "depth"), [(0.0, 2e-6), (5e-5, 1.5e-5), (1e-4, -1e-6), (8e-5, 2e-6)])
 def test_edge_location_matches_dense_search(chain: str, radius: float, depth: float) -> None:
     row = make_row(chain)
-    new_radius, _, grow = _kernels._locate_edge(radius, depth, row.wsum, row.dx, row.g_c, row.gf, row.df,
-                                                row.c_crit, row.reach, row.kap)
+    new_radius, _, grow = _kernels._locate_edge(
+        radius, depth, row.wsum, row.dx, row.g_c, row.gf, row.df, row.c_crit, row.reach, row.kap
+    )
     assert not grow
-    np.testing.assert_allclose(new_radius, naive.locate_edge(row, radius, depth), rtol=0, atol=1e-5 * row.length,
-                               err_msg=f"{chain} a={radius} d={depth}")
+    np.testing.assert_allclose(
+        new_radius,
+        naive.locate_edge(row, radius, depth),
+        rtol=0,
+        atol=1e-5 * row.length,
+        err_msg=f"{chain} a={radius} d={depth}",
+    )
 
 
 def test_advance_without_edge_motion_is_the_exact_chain_update() -> None:
@@ -111,8 +138,12 @@ def test_advance_without_edge_motion_is_the_exact_chain_update() -> None:
     status, out = _kernels.advance(row, radius, depth, depth, 0.5, max_substep=0.0, max_edge_move=row.dx)
     assert status == _kernels.STATUS_OK
     np.testing.assert_allclose(row.wl, expected, rtol=1e-9, atol=1e-15, err_msg="chains")
-    np.testing.assert_allclose(out[_kernels.OUT_FORCE], _kernels.force(row, out[_kernels.OUT_RADIUS], depth),
-                               rtol=1e-12, err_msg="force")
+    np.testing.assert_allclose(
+        out[_kernels.OUT_FORCE],
+        _kernels.force(row, out[_kernels.OUT_RADIUS], depth),
+        rtol=1e-12,
+        err_msg="force",
+    )
     assert out[_kernels.OUT_WORK] == 0.0
 
 

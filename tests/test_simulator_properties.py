@@ -7,7 +7,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -16,17 +15,28 @@ from viscoadh_ros.core.config import SceneConfig
 from viscoadh_ros.core.history import simulate_history
 from viscoadh_ros.core.rheology import CreepElement
 
-QUICK = settings(max_examples=25, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
+QUICK = settings(
+    max_examples=25, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow]
+)
 G0 = 1e6
 
 
 def make_contact(*, radius, kelvin, viscosities, work, elements=0, shape="sphere"):
-    scene = SceneConfig.from_dict({"contacts": ["c"], "c": {
-        "indenter": {"shape": shape, "radius": radius},
-        "material": {"glass_shear_modulus": G0, "kelvin_shear_moduli": list(kelvin),
-                     "kelvin_viscosities": list(viscosities)},
-        "adhesion": {"work_of_adhesion": work},
-        "numerics": {"model": "time_stepped", **({"elements": elements} if elements else {})}}})
+    scene = SceneConfig.from_dict(
+        {
+            "contacts": ["c"],
+            "c": {
+                "indenter": {"shape": shape, "radius": radius},
+                "material": {
+                    "glass_shear_modulus": G0,
+                    "kelvin_shear_moduli": list(kelvin),
+                    "kelvin_viscosities": list(viscosities),
+                },
+                "adhesion": {"work_of_adhesion": work},
+                "numerics": {"model": "time_stepped", **({"elements": elements} if elements else {})},
+            },
+        }
+    )
     return scene.contact("c")
 
 
@@ -35,13 +45,20 @@ def chain(log_ratio: float, log_tau: float, spread: float) -> tuple[list[float],
     g1 = G0 / 10.0**log_ratio
     kelvin = [2.0 * g1, 2.0 * g1]
     taus = [10.0**log_tau, 10.0 ** (log_tau + spread)]
-    return kelvin, [t * (G0 + k) for t, k in zip(taus, kelvin)]
+    return kelvin, [t * (G0 + k) for t, k in zip(taus, kelvin, strict=True)]
 
 
 @QUICK
-@given(log_ratio=st.floats(0.0, 6.0), log_tau=st.floats(-6.0, 4.0), spread=st.floats(0.0, 3.0),
-       log_dt=st.floats(-6.0, 0.0), log_radius=st.floats(-6.0, 0.0))
-def test_non_adhesive_force_between_glass_and_relaxed_hertz(log_ratio, log_tau, spread, log_dt, log_radius) -> None:
+@given(
+    log_ratio=st.floats(0.0, 6.0),
+    log_tau=st.floats(-6.0, 4.0),
+    spread=st.floats(0.0, 3.0),
+    log_dt=st.floats(-6.0, 0.0),
+    log_radius=st.floats(-6.0, 0.0),
+)
+def test_non_adhesive_force_between_glass_and_relaxed_hertz(
+    log_ratio, log_tau, spread, log_dt, log_radius
+) -> None:
     radius, dt = 10.0**log_radius, 10.0**log_dt
     kelvin, viscosities = chain(log_ratio, log_tau, spread)
     contact = make_contact(radius=radius, kelvin=kelvin, viscosities=viscosities, work=0.0)
@@ -61,10 +78,17 @@ def test_non_adhesive_force_between_glass_and_relaxed_hertz(log_ratio, log_tau, 
 
 
 @QUICK
-@given(log_ratio=st.floats(0.0, 6.0), log_tau=st.floats(-6.0, 4.0), log_dt=st.floats(-6.0, 0.0),
-       work=st.one_of(st.just(0.0), st.floats(1e-3, 10.0)), log_radius=st.floats(-6.0, 0.0),
-       amplitude=st.floats(0.5, 4.0))
-def test_adhesive_cycles_stay_finite_and_dissipative(log_ratio, log_tau, log_dt, work, log_radius, amplitude) -> None:
+@given(
+    log_ratio=st.floats(0.0, 6.0),
+    log_tau=st.floats(-6.0, 4.0),
+    log_dt=st.floats(-6.0, 0.0),
+    work=st.one_of(st.just(0.0), st.floats(1e-3, 10.0)),
+    log_radius=st.floats(-6.0, 0.0),
+    amplitude=st.floats(0.5, 4.0),
+)
+def test_adhesive_cycles_stay_finite_and_dissipative(
+    log_ratio, log_tau, log_dt, work, log_radius, amplitude
+) -> None:
     radius, dt = 10.0**log_radius, 10.0**log_dt
     kelvin, viscosities = chain(log_ratio, log_tau, 1.0)
     contact = make_contact(radius=radius, kelvin=kelvin, viscosities=viscosities, work=work)
@@ -88,14 +112,17 @@ def test_converges_as_elements_double() -> None:
     pull-off the force falls steeply in time and one row can differ by a few percent.)"""
     work, radius = 0.05, 1e-3
     kelvin, viscosities = [1e5], [1e-2 * 1.1e6]
-    element = CreepElement.from_config(make_contact(radius=radius, kelvin=kelvin, viscosities=viscosities,
-                                                    work=work).material)
+    element = CreepElement.from_config(
+        make_contact(radius=radius, kelvin=kelvin, viscosities=viscosities, work=work).material
+    )
     d_c = abs(reference.figure4_scales(radius, work, element).depth)
     time = np.linspace(0.0, 0.2, 201)
     depth = d_c * (3.0 * np.sin(np.pi * time / 0.2) - 1.0)
 
     def force(elements: int) -> np.ndarray:
-        contact = make_contact(radius=radius, kelvin=kelvin, viscosities=viscosities, work=work, elements=elements)
+        contact = make_contact(
+            radius=radius, kelvin=kelvin, viscosities=viscosities, work=work, elements=elements
+        )
         return simulate_history(contact, time, depth=depth).force
 
     exact = force(640)

@@ -24,9 +24,17 @@ def make_contact(*, kelvin=(G1,), viscosities=(TAU * (G0 + G1),), work=0.0, shap
     material = {"glass_shear_modulus": G0}
     if kelvin:
         material.update(kelvin_shear_moduli=list(kelvin), kelvin_viscosities=list(viscosities))
-    scene = SceneConfig.from_dict({"contacts": ["c"], "c": {
-        "indenter": {"shape": shape, "radius": R}, "material": material,
-        "adhesion": {"work_of_adhesion": work}, "numerics": {"model": "time_stepped", **numerics}}})
+    scene = SceneConfig.from_dict(
+        {
+            "contacts": ["c"],
+            "c": {
+                "indenter": {"shape": shape, "radius": R},
+                "material": material,
+                "adhesion": {"work_of_adhesion": work},
+                "numerics": {"model": "time_stepped", **numerics},
+            },
+        }
+    )
     return scene.contact("c")
 
 
@@ -52,25 +60,34 @@ def test_standard_solid_quasistatic_cycle() -> None:
         w_eff = w1 if i <= turn else w2
         case = f"row {i} phase {phase} d/d_c={depth[i] / scales.depth:.3f}"
         assert phase == (Phase.INDENTING if i <= turn else Phase.DETACHING), case
-        np.testing.assert_allclose(result.force[i], reference.jkr_force(a, R, e_r, w_eff), rtol=0,
-                                   atol=1e-2 * f_c, err_msg=case)
+        np.testing.assert_allclose(
+            result.force[i], reference.jkr_force(a, R, e_r, w_eff), rtol=0, atol=1e-2 * f_c, err_msg=case
+        )
         np.testing.assert_allclose(result.effective_work_of_adhesion[i], w_eff, rtol=2e-2, err_msg=case)
     sticking = np.flatnonzero(result.phase == Phase.STICKING)
     assert sticking.size > 100 and sticking[0] == turn + 1, "no sticking zone right after reversal"
     a_max = result.contact_radius[turn]
-    np.testing.assert_array_equal(result.contact_radius[sticking], a_max, err_msg="radius moves while sticking")
+    np.testing.assert_array_equal(
+        result.contact_radius[sticking], a_max, err_msg="radius moves while sticking"
+    )
     # Sticking ends where the relaxed edge reaches the detachment criterion: JKR(E_r*, w_eff2).
     end = sticking[-1] + 1
     step = abs(depth[1] - depth[0]) * 3
-    np.testing.assert_allclose(depth[end], reference.jkr_depth(a_max, R, e_r, w2), rtol=0, atol=step,
-                               err_msg="end of the sticking zone")
+    np.testing.assert_allclose(
+        depth[end],
+        reference.jkr_depth(a_max, R, e_r, w2),
+        rtol=0,
+        atol=step,
+        err_msg="end of the sticking zone",
+    )
     np.testing.assert_allclose(result.force.min(), -1.5 * math.pi * R * w2, rtol=2e-2, err_msg="pull-off")
     assert result.contact_radius[-1] == 0.0
     assert np.all(result.energy_dissipated >= -1e-9 * result.energy_input.max()), "negative dissipation"
 
 
-@pytest.mark.parametrize(("kelvin", "viscosities"), [((G1,), (TAU * (G0 + G1),)),
-                                                      ((3e5, 1e5, 5e5), (1e2, 1e3, 1e0))])
+@pytest.mark.parametrize(
+    ("kelvin", "viscosities"), [((G1,), (TAU * (G0 + G1),)), ((3e5, 1e5, 5e5), (1e2, 1e3, 1e0))]
+)
 def test_lee_radok_ramp(kelvin, viscosities) -> None:
     """Non-adhesive ramp d = v t against the exact hereditary integral."""
     contact = make_contact(kelvin=kelvin, viscosities=viscosities)
@@ -78,7 +95,9 @@ def test_lee_radok_ramp(kelvin, viscosities) -> None:
     t_end = 5.0 * float(np.max(element.relaxation_times))
     speed = 1e-5 / t_end
     time = np.linspace(0.0, t_end, 201)[1:]
-    result = simulate_history(contact, np.concatenate([[0.0], time]), depth=np.concatenate([[0.0], speed * time]))
+    result = simulate_history(
+        contact, np.concatenate([[0.0], time]), depth=np.concatenate([[0.0], speed * time])
+    )
     expected = reference.lee_radok_ramp_force(time, speed, R, element)
     np.testing.assert_allclose(result.force[1:], expected, rtol=5e-3, err_msg=f"Lee-Radok K={len(kelvin)}")
 
@@ -94,8 +113,13 @@ def test_coarse_history_converges_to_fine() -> None:
     fine_time = np.linspace(0.0, 20 * TAU, 2401)
     coarse = simulate_history(contact, coarse_time, depth=coarse_depth)
     fine = simulate_history(contact, fine_time, depth=np.interp(fine_time, coarse_time, coarse_depth))
-    np.testing.assert_allclose(coarse.force, fine.force[::100], rtol=0, atol=5e-3 * np.abs(fine.force).max(),
-                               err_msg="coarse vs fine rows")
+    np.testing.assert_allclose(
+        coarse.force,
+        fine.force[::100],
+        rtol=0,
+        atol=5e-3 * np.abs(fine.force).max(),
+        err_msg="coarse vs fine rows",
+    )
 
 
 def test_domain_grows_instead_of_clipping() -> None:
@@ -104,13 +128,15 @@ def test_domain_grows_instead_of_clipping() -> None:
     time = np.linspace(0.0, 5 * TAU, depth.size)
     small = ContactSimulator(make_contact(domain_radius=1e-6))
     big = ContactSimulator(make_contact(domain_radius=2e-4))
-    for t, d in zip(time, depth):
+    for t, d in zip(time, depth, strict=True):
         out_small, out_big = small.step(float(t), depth=float(d)), big.step(float(t), depth=float(d))
     assert small._model.row.length >= out_small.contact_radius > 1e-6
     np.testing.assert_allclose(out_small.force, out_big.force, rtol=5e-3, err_msg="grown vs big domain")
     elastic = ContactSimulator(make_contact(kelvin=(), viscosities=(), domain_radius=1e-6))
     out = elastic.step(1.0, depth=2e-5)
-    np.testing.assert_allclose(out.force, reference.hertz_force(2e-5, R, 4 * G0), rtol=5e-3, err_msg="grown Hertz")
+    np.testing.assert_allclose(
+        out.force, reference.hertz_force(2e-5, R, 4 * G0), rtol=5e-3, err_msg="grown Hertz"
+    )
 
 
 def test_idle_contact_costs_nothing_and_keeps_no_memory() -> None:
@@ -152,8 +178,12 @@ def test_predict_pull_off_leaves_the_live_state_alone() -> None:
     prediction = predict_pull_off(sim, retract_speed=1e-3)
     assert sim.output == before and sim.time == before.time
     assert prediction.detached and "detached" in prediction.message
-    np.testing.assert_allclose(prediction.pull_off_force, -1.5 * math.pi * R * work, rtol=1e-2,
-                               err_msg="elastic pull-off by retraction")
+    np.testing.assert_allclose(
+        prediction.pull_off_force,
+        -1.5 * math.pi * R * work,
+        rtol=1e-2,
+        err_msg="elastic pull-off by retraction",
+    )
     assert prediction.time_to_detach > 0.0 and prediction.pull_off_depth < 3e-6
     assert sim.step(2e-3, depth=3e-6).force == pytest.approx(before.force, rel=1e-9)
     with pytest.raises(InputError, match="retract_speed"):
@@ -177,8 +207,12 @@ def test_bad_input_names_the_parameter_and_changes_nothing() -> None:
     sim = ContactSimulator(make_contact())
     sim.step(0.01, depth=1e-6)
     before = sim.output
-    for kwargs, match in (({"depth": math.nan}, "depth"), ({"force": math.inf}, "force"),
-                          ({"depth": 1e-6, "force": 1.0}, "exactly one"), ({}, "exactly one")):
+    for kwargs, match in (
+        ({"depth": math.nan}, "depth"),
+        ({"force": math.inf}, "force"),
+        ({"depth": 1e-6, "force": 1.0}, "exactly one"),
+        ({}, "exactly one"),
+    ):
         with pytest.raises(InputError, match=match):
             sim.step(0.02, **kwargs)
     with pytest.raises(InputError, match="time"):

@@ -377,15 +377,39 @@ def _retime_crossed(wl, wsum, scratch, a0, a1, da, db, dt, dx, g_c, p, p_inv, la
 
 
 @numba.njit(cache=True)
-def _advance(wl, wsum, scratch, a, d0, d1, dt, dx, g_c, gf, gint, df, e0, c_crit, reach,
-             p, p_inv, lam, beta, rate, kap, max_substep, max_edge_move, out):
+def _advance(
+    wl,
+    wsum,
+    scratch,
+    a,
+    d0,
+    d1,
+    dt,
+    dx,
+    g_c,
+    gf,
+    gint,
+    df,
+    e0,
+    c_crit,
+    reach,
+    p,
+    p_inv,
+    lam,
+    beta,
+    rate,
+    kap,
+    max_substep,
+    max_edge_move,
+    out,
+):
     """Advance the row from depth d0 to d1 (linear in time) over dt with adaptive substeps.
 
     Substeps are halved while the edge would move more than ``max_edge_move`` (m) in one
     of them, down to ``1e-7 dt``: a true jump (snap-in, the fold at pull-off) is thereby
-    located in time and crossed in one tiny substep that does no work. Writes radius, force, work input, last motion and substep count to
-    ``out``. Returns STATUS_GROW (state partly advanced: the caller restores) when the
-    contact needs a larger domain.
+    located in time and crossed in one tiny substep that does no work. Writes radius,
+    force, work input, last motion and substep count to ``out``. Returns STATUS_GROW
+    (state partly advanced: the caller restores) when the contact needs a larger domain.
     """
     n = wl.shape[0]
     h_min = dt * 1e-7
@@ -533,10 +557,26 @@ class Row:
     glass elongation per sqrt(m), ``dl_c(x) = c_crit sqrt(x)``.
     """
 
-    def __init__(self, *, dx: float, g_c: np.ndarray, gf: np.ndarray, gint: np.ndarray,
-                 df: float, reach: float, wl: np.ndarray, p: np.ndarray, p_inv: np.ndarray,
-                 lam: np.ndarray, beta: np.ndarray, rate: np.ndarray, e_kelvin: np.ndarray,
-                 steady: np.ndarray, e0: float, c_crit: float) -> None:
+    def __init__(
+        self,
+        *,
+        dx: float,
+        g_c: np.ndarray,
+        gf: np.ndarray,
+        gint: np.ndarray,
+        df: float,
+        reach: float,
+        wl: np.ndarray,
+        p: np.ndarray,
+        p_inv: np.ndarray,
+        lam: np.ndarray,
+        beta: np.ndarray,
+        rate: np.ndarray,
+        e_kelvin: np.ndarray,
+        steady: np.ndarray,
+        e0: float,
+        c_crit: float,
+    ) -> None:
         n, k = wl.shape
         m = gf.shape[0]
         _check_scalars(dx=dx, df=df, e0=e0, c_crit=c_crit)
@@ -547,9 +587,16 @@ class Row:
         if e0 <= 0.0 or c_crit < 0.0:
             raise ValueError(f"e0 must be > 0 and c_crit >= 0 (got {e0!r}, {c_crit!r})")
         for name, array, shape in (
-            ("g_c", g_c, (n,)), ("gf", gf, (m,)), ("gint", gint, (m,)), ("wl", wl, (n, k)),
-            ("p", p, (k, k)), ("p_inv", p_inv, (k, k)), ("lam", lam, (k,)),
-            ("beta", beta, (k,)), ("rate", rate, (k,)), ("e_kelvin", e_kelvin, (k,)),
+            ("g_c", g_c, (n,)),
+            ("gf", gf, (m,)),
+            ("gint", gint, (m,)),
+            ("wl", wl, (n, k)),
+            ("p", p, (k, k)),
+            ("p_inv", p_inv, (k, k)),
+            ("lam", lam, (k,)),
+            ("beta", beta, (k,)),
+            ("rate", rate, (k,)),
+            ("e_kelvin", e_kelvin, (k,)),
             ("steady", steady, (k,)),
         ):
             _check(name, array, shape)
@@ -573,7 +620,7 @@ class Row:
         """Domain length L, m."""
         return self.dx * self.elements
 
-    def with_memory(self, wl: np.ndarray) -> "Row":
+    def with_memory(self, wl: np.ndarray) -> Row:
         """A new row with the same geometry and chain (shared, never written) and its own
         copy of the Kelvin state `wl` (N, K)."""
         clone = object.__new__(Row)
@@ -592,8 +639,9 @@ class Row:
         self.wsum[...] = wl.sum(axis=1)
 
 
-def advance(row: Row, radius: float, d0: float, d1: float, dt: float, *, max_substep: float,
-            max_edge_move: float) -> tuple[int, np.ndarray]:
+def advance(
+    row: Row, radius: float, d0: float, d1: float, dt: float, *, max_substep: float, max_edge_move: float
+) -> tuple[int, np.ndarray]:
     """Advance `row` in place over dt (s) from depth d0 to d1 (m, linear in time), the
     contact radius starting at `radius` (m).
 
@@ -604,25 +652,63 @@ def advance(row: Row, radius: float, d0: float, d1: float, dt: float, *, max_sub
     _check_scalars(radius=radius, d0=d0, d1=d1, dt=dt, max_edge_move=max_edge_move)
     if dt < 0.0 or radius < 0.0 or max_edge_move <= 0.0 or not max_substep >= 0.0:
         raise ValueError("dt, radius and max_substep must be >= 0 and max_edge_move > 0")
-    status = _advance(row.wl, row.wsum, row.scratch, float(radius), float(d0), float(d1),
-                      float(dt), row.dx, row.g_c, row.gf, row.gint, row.df, row.e0,
-                      row.c_crit, row.reach, row.p, row.p_inv, row.lam, row.beta,
-                      row.rate, row.kap, float(max_substep), float(max_edge_move), row.out)
+    status = _advance(
+        row.wl,
+        row.wsum,
+        row.scratch,
+        float(radius),
+        float(d0),
+        float(d1),
+        float(dt),
+        row.dx,
+        row.g_c,
+        row.gf,
+        row.gint,
+        row.df,
+        row.e0,
+        row.c_crit,
+        row.reach,
+        row.p,
+        row.p_inv,
+        row.lam,
+        row.beta,
+        row.rate,
+        row.kap,
+        float(max_substep),
+        float(max_edge_move),
+        row.out,
+    )
     return int(status), row.out
 
 
 def force(row: Row, radius: float, depth: float) -> float:
     """Normal force, N, of the row at contact radius (m) and depth (m)."""
     _check_scalars(radius=radius, depth=depth)
-    return float(_force(float(radius), float(depth), row.wsum, row.dx, row.g_c, row.gf,
-                        row.gint, row.df, row.e0, row.kap))
+    return float(
+        _force(
+            float(radius), float(depth), row.wsum, row.dx, row.g_c, row.gf, row.gint, row.df, row.e0, row.kap
+        )
+    )
 
 
 def stored_energy(row: Row, radius: float, depth: float) -> float:
     """Elastic energy stored in glass and Kelvin springs of the row, J."""
     _check_scalars(radius=radius, depth=depth)
-    return float(_stored_energy(float(radius), float(depth), row.wl, row.wsum, row.dx,
-                                row.g_c, row.gf, row.df, row.e0, row.e_kelvin, row.steady))
+    return float(
+        _stored_energy(
+            float(radius),
+            float(depth),
+            row.wl,
+            row.wsum,
+            row.dx,
+            row.g_c,
+            row.gf,
+            row.df,
+            row.e0,
+            row.e_kelvin,
+            row.steady,
+        )
+    )
 
 
 def criterion_gap(row: Row, x: float, depth: float, radius: float, *, interior: bool) -> float:
@@ -631,8 +717,21 @@ def criterion_gap(row: Row, x: float, depth: float, radius: float, *, interior: 
     n = row.elements
     n_in = int(_interior_count(float(radius), row.dx, n))
     lo, hi = (0, n_in - 1) if interior else (n_in, n - 1)
-    return float(_h(float(x), float(depth), row.wsum, lo, hi, row.dx, row.g_c, row.gf,
-                    row.df, row.c_crit, row.kap if interior else 0.0))
+    return float(
+        _h(
+            float(x),
+            float(depth),
+            row.wsum,
+            lo,
+            hi,
+            row.dx,
+            row.g_c,
+            row.gf,
+            row.df,
+            row.c_crit,
+            row.kap if interior else 0.0,
+        )
+    )
 
 
 def kelvin_update(row: Row, n_in: int, d0: float, d1: float, dt: float) -> None:
@@ -642,8 +741,20 @@ def kelvin_update(row: Row, n_in: int, d0: float, d1: float, dt: float) -> None:
         raise ValueError(f"n_in must be in [0, {row.elements}] (got {n_in})")
     if dt < 0.0:
         raise ValueError(f"dt must be >= 0 (got {dt!r})")
-    _kelvin_update(row.wl, row.wsum, int(n_in), float(d0), float(d1), float(dt), row.g_c,
-                   row.p, row.p_inv, row.lam, row.beta, row.rate)
+    _kelvin_update(
+        row.wl,
+        row.wsum,
+        int(n_in),
+        float(d0),
+        float(d1),
+        float(dt),
+        row.g_c,
+        row.p,
+        row.p_inv,
+        row.lam,
+        row.beta,
+        row.rate,
+    )
 
 
 def warm_up() -> None:
@@ -653,9 +764,24 @@ def warm_up() -> None:
     x = (np.arange(n) + 0.5) * 0.25
     xf = np.linspace(0.0, 1.0, m)
     one = np.ones(k)
-    row = Row(dx=0.25, g_c=x**2, gf=xf**2, gint=xf**3 / 3.0, df=float(xf[1]), reach=math.inf,
-              wl=np.zeros((n, k)), p=np.eye(k), p_inv=np.eye(k), lam=2.0 * one, beta=one.copy(),
-              rate=one.copy(), e_kelvin=one.copy(), steady=0.5 * one, e0=1.0, c_crit=0.1)
+    row = Row(
+        dx=0.25,
+        g_c=x**2,
+        gf=xf**2,
+        gint=xf**3 / 3.0,
+        df=float(xf[1]),
+        reach=math.inf,
+        wl=np.zeros((n, k)),
+        p=np.eye(k),
+        p_inv=np.eye(k),
+        lam=2.0 * one,
+        beta=one.copy(),
+        rate=one.copy(),
+        e_kelvin=one.copy(),
+        steady=0.5 * one,
+        e0=1.0,
+        c_crit=0.1,
+    )
     advance(row, 0.0, 0.0, 0.1, 0.01, max_substep=0.0, max_edge_move=0.25)
     force(row, 0.3, 0.1)
     stored_energy(row, 0.3, 0.1)

@@ -53,7 +53,7 @@ class HistoryResult:
         return {name: getattr(self, name) for name in STEP_OUTPUT_FIELDS}
 
     @classmethod
-    def from_outputs(cls, outputs: list[StepOutput], model: str) -> "HistoryResult":
+    def from_outputs(cls, outputs: list[StepOutput], model: str) -> HistoryResult:
         dtypes = {"phase": np.uint8, "scale_separation_ok": np.bool_, "unstable": np.bool_}
         arrays = {
             name: np.array([getattr(o, name) for o in outputs], dtype=dtypes.get(name, np.float64))
@@ -75,8 +75,9 @@ def _history_array(name: str, values: ArrayLike) -> FloatArray:
     return array
 
 
-def simulate_history(contact: Any, time: ArrayLike, *, depth: ArrayLike | None = None,
-                     force: ArrayLike | None = None) -> HistoryResult:
+def simulate_history(
+    contact: Any, time: ArrayLike, *, depth: ArrayLike | None = None, force: ArrayLike | None = None
+) -> HistoryResult:
     """Run a history from a fresh, undeformed state of `contact` (a ContactConfig).
 
     time: sample times, s, shape (n,), n >= 1, strictly increasing. Exactly one of
@@ -96,10 +97,14 @@ def simulate_history(contact: Any, time: ArrayLike, *, depth: ArrayLike | None =
     steps = np.flatnonzero(np.diff(times) <= 0.0)
     if steps.size:
         i = int(steps[0]) + 1
-        raise InputError(f"time must be strictly increasing (time[{i}] = {times[i]!r} after {times[i - 1]!r})")
+        raise InputError(
+            f"time must be strictly increasing (time[{i}] = {times[i]!r} after {times[i - 1]!r})"
+        )
     simulator = ContactSimulator(contact)
     simulator.reset(float(times[0]))
-    outputs = [simulator.step(float(t), **{control_name: float(c)}) for t, c in zip(times, control)]
+    outputs = [
+        simulator.step(float(t), **{control_name: float(c)}) for t, c in zip(times, control, strict=True)
+    ]
     return HistoryResult.from_outputs(outputs, simulator.model)
 
 
@@ -158,6 +163,8 @@ def predict_pull_off(simulator: ContactSimulator, retract_speed: float) -> PullO
     if detached:
         message = f"detached after {elapsed:.6g} s of retraction at {speed:g} m/s"
     else:
-        message = (f"still in contact after retracting {speed * elapsed:.6g} m "
-                   f"({PULL_OFF_RANGES} characteristic depth ranges); the values are up to there")
+        message = (
+            f"still in contact after retracting {speed * elapsed:.6g} m "
+            f"({PULL_OFF_RANGES} characteristic depth ranges); the values are up to there"
+        )
     return PullOffPrediction(best_force, best_depth, elapsed, detached, message)

@@ -35,7 +35,8 @@ Outputs (`StepOutput`), beyond depth, force and radius:
   with relaxation over the interaction range h (paper, section 5). With
   ``v_c1 = pi G0 h^2 / (tau w)`` (tau = the shortest relaxation time, the strict side)
   and ``v_c2 = v_c1 (G_inf/G0)^2`` (`criterion.critical_edge_speeds`): an advancing edge
-  needs ``|edge_speed| >= v_c1``, a receding one ``|edge_speed| >= v_c2``. A pinned edge, no contact, an elastic material
+  needs ``|edge_speed| >= v_c1``, a receding one ``|edge_speed| >= v_c2``. A pinned
+  edge, no contact, an elastic material
   or ``w = 0`` are always ok.
 """
 
@@ -97,7 +98,9 @@ class _Physics:
         self.work_of_adhesion = require_finite("adhesion.work_of_adhesion", contact.adhesion.work_of_adhesion)
         if self.work_of_adhesion < 0.0:
             raise InputError(f"adhesion.work_of_adhesion must be >= 0 (got {self.work_of_adhesion!r})")
-        self.interaction_range = require_finite("adhesion.interaction_range", contact.adhesion.interaction_range)
+        self.interaction_range = require_finite(
+            "adhesion.interaction_range", contact.adhesion.interaction_range
+        )
         if self.interaction_range <= 0.0:
             raise InputError(f"adhesion.interaction_range must be > 0 (got {self.interaction_range!r})")
         self.e0 = self.creep.glass_modulus_star
@@ -124,7 +127,11 @@ class _Physics:
         effective work (``w (E0*/E_r*)``), m: the natural domain scale of an adhesive scene."""
         w_eff = self.work_of_adhesion * self.e0 / self.e_relaxed
         c = math.sqrt(2.0 * math.pi * w_eff / self.e_relaxed)
-        x = max(self.profile.characteristic_radius, 1e-30) if math.isfinite(self.profile.characteristic_radius) else 1.0
+        x = (
+            max(self.profile.characteristic_radius, 1e-30)
+            if math.isfinite(self.profile.characteristic_radius)
+            else 1.0
+        )
         # g(x) = c sqrt(x): shrink/grow x geometrically to bracket, then bisect.
         lo, hi = x, x
         while float(self.profile.g(lo)) > c * math.sqrt(lo) and lo > 1e-300:
@@ -164,7 +171,11 @@ class _ClosedForm:
             return "the material has Kelvin elements (memory)"
         if physics.profile.kind not in ("sphere", "cone", "flat_punch", "power_law"):
             return f"indenter.shape {physics.profile.kind!r} has no closed form"
-        if physics.profile.kind == "power_law" and physics.work_of_adhesion > 0.0 and physics.profile.exponent <= 0.5:
+        if (
+            physics.profile.kind == "power_law"
+            and physics.work_of_adhesion > 0.0
+            and physics.profile.exponent <= 0.5
+        ):
             return "a power law with exponent <= 0.5 has no adhesive equilibrium"
         return ""
 
@@ -307,11 +318,22 @@ class _TimeStepped:
         k = self.e_kelvin.size
         wl = np.zeros((n, k)) if memory is None else memory
         return _kernels.Row(
-            dx=dx, g_c=np.asarray(profile.g(centres), dtype=np.float64),
+            dx=dx,
+            g_c=np.asarray(profile.g(centres), dtype=np.float64),
             gf=np.asarray(profile.g(fine), dtype=np.float64),
-            gint=np.asarray(profile.g_integral(fine), dtype=np.float64), df=fine[1], reach=reach,
-            wl=wl, p=self.p, p_inv=self.p_inv, lam=self.lam, beta=self.beta, rate=self.rate,
-            e_kelvin=self.e_kelvin, steady=self.steady, e0=self.physics.e0, c_crit=self.physics.c_crit,
+            gint=np.asarray(profile.g_integral(fine), dtype=np.float64),
+            df=fine[1],
+            reach=reach,
+            wl=wl,
+            p=self.p,
+            p_inv=self.p_inv,
+            lam=self.lam,
+            beta=self.beta,
+            rate=self.rate,
+            e_kelvin=self.e_kelvin,
+            steady=self.steady,
+            e0=self.physics.e0,
+            c_crit=self.physics.c_crit,
         )
 
     def _grow(self) -> None:
@@ -352,14 +374,22 @@ class _TimeStepped:
         while True:
             row = self.row
             status, out = _kernels.advance(
-                row, self.radius, d0, d1, dt, max_substep=self.numerics.max_substep, max_edge_move=self.numerics.max_edge_cells * row.dx,
+                row,
+                self.radius,
+                d0,
+                d1,
+                dt,
+                max_substep=self.numerics.max_substep,
+                max_edge_move=self.numerics.max_edge_cells * row.dx,
             )
             if status == _kernels.STATUS_OK:
                 break
             self.set_state(start)
             if self.row is None:
-                self.row = self._build_row(self.initial_length or 1.25 * float(
-                    self.physics.profile.radius_at_height(max(d0, d1))), None)
+                self.row = self._build_row(
+                    self.initial_length or 1.25 * float(self.physics.profile.radius_at_height(max(d0, d1))),
+                    None,
+                )
             self._grow()
             start = self.get_state()
         self.radius = float(out[_kernels.OUT_RADIUS])
@@ -384,7 +414,10 @@ class _TimeStepped:
             return True
         if self.radius > 0.0:
             return False
-        return float(np.max(np.abs(self.row.wsum), initial=0.0)) <= self.numerics.idle_tolerance * self.row.length
+        return (
+            float(np.max(np.abs(self.row.wsum), initial=0.0))
+            <= self.numerics.idle_tolerance * self.row.length
+        )
 
     def drop_memory(self) -> None:
         """Forget a relaxed, out-of-contact state: the next contact sizes a fresh domain."""
@@ -469,7 +502,7 @@ class ContactSimulator:
     # -- public state ---------------------------------------------------------------------
     @property
     def model(self) -> str:
-        """"closed_form" or "time_stepped": the model path computing this contact."""
+        """ "closed_form" or "time_stepped": the model path computing this contact."""
         return self._model.name
 
     @property
@@ -496,7 +529,9 @@ class ContactSimulator:
         self._depth = 0.0
         self._energy_input = 0.0
         self._model.reset()
-        self._output = StepOutput(self._time, 0.0, 0.0, 0.0, Phase.NO_CONTACT, 0.0, 0.0, 0.0, 0.0, True, False)
+        self._output = StepOutput(
+            self._time, 0.0, 0.0, 0.0, Phase.NO_CONTACT, 0.0, 0.0, 0.0, 0.0, True, False
+        )
 
     def snapshot(self) -> Snapshot:
         return Snapshot(self._model.get_state(), self._time, self._depth, self._output, self._energy_input)
@@ -545,8 +580,9 @@ class ContactSimulator:
         self._output = self._make_output(time, depth, force, r0, radius, dt, unstable)
         return self._output
 
-    def _make_output(self, time: float, depth: float, force: float, r0: float, radius: float,
-                     dt: float, unstable: bool) -> StepOutput:
+    def _make_output(
+        self, time: float, depth: float, force: float, r0: float, radius: float, dt: float, unstable: bool
+    ) -> StepOutput:
         physics = self.physics
         if radius <= 0.0:
             phase = Phase.NO_CONTACT
@@ -569,10 +605,17 @@ class ContactSimulator:
         stored = self._model.stored_energy(depth)
         dissipated = self._energy_input - stored + physics.work_of_adhesion * math.pi * radius * radius
         return StepOutput(
-            time=time, depth=depth, force=force, contact_radius=radius, phase=phase,
-            edge_speed=edge_speed, effective_work_of_adhesion=physics.effective_work(depth, radius),
-            energy_input=self._energy_input, energy_dissipated=dissipated,
-            scale_separation_ok=physics.scale_separation_ok(edge_speed), unstable=unstable,
+            time=time,
+            depth=depth,
+            force=force,
+            contact_radius=radius,
+            phase=phase,
+            edge_speed=edge_speed,
+            effective_work_of_adhesion=physics.effective_work(depth, radius),
+            energy_input=self._energy_input,
+            energy_dissipated=dissipated,
+            scale_separation_ok=physics.scale_separation_ok(edge_speed),
+            unstable=unstable,
         )
 
     # -- force control ----------------------------------------------------------------------
@@ -583,8 +626,11 @@ class ContactSimulator:
             row = getattr(self._model, "row", None)
             radius = row.length if row is not None else getattr(self._model, "initial_length", 0.0)
         if radius <= 0.0:
-            radius = max(self.physics.adhesion_length() if self.physics.work_of_adhesion > 0.0 else 0.0,
-                         abs(self._depth), 1e-9)
+            radius = max(
+                self.physics.adhesion_length() if self.physics.work_of_adhesion > 0.0 else 0.0,
+                abs(self._depth),
+                1e-9,
+            )
         return 2.0 * self.physics.e_relaxed * radius
 
     def _solve_force(self, time: float, target: float) -> StepOutput:
@@ -625,8 +671,14 @@ class ContactSimulator:
             delta *= 2.0
         else:
             raise InputError(f"force {target!r} N cannot be reached from depth {d0!r} m")
-        root = brentq(residual, min(lo, hi), max(lo, hi), xtol=1e-15 * max(abs(lo), abs(hi), 1e-300),
-                      rtol=1e-15, maxiter=200)
+        root = brentq(
+            residual,
+            min(lo, hi),
+            max(lo, hi),
+            xtol=1e-15 * max(abs(lo), abs(hi), 1e-300),
+            rtol=1e-15,
+            maxiter=200,
+        )
         r_root = residual(root)
         jumped_in = not was_in_contact and self.in_contact and self.physics.work_of_adhesion > 0.0
         if abs(r_root) > max(tol, 1e-9 * abs(target)) or jumped_in:
@@ -640,7 +692,6 @@ class ContactSimulator:
         """Between an attached and a detached trial depth, look for a force below the target
         that the bracketing step skipped (the minimum of F(d) lies before the fold)."""
         lo, hi = detached, attached
-        best, r_best = attached, residual(attached)
         for _ in range(60):
             mid = 0.5 * (lo + hi)
             r_mid = residual(mid)
@@ -648,8 +699,6 @@ class ContactSimulator:
                 lo = mid
             else:
                 hi = mid
-                if r_mid < r_best:
-                    best, r_best = mid, r_mid
                 if r_mid <= 0.0:
                     return mid, r_mid
             if hi - lo <= 1e-13 * max(abs(hi), abs(lo), 1e-300):

@@ -40,13 +40,18 @@ def read_history(path: str | Path) -> History:
             lines = list(enumerate(csv.reader(handle), start=1))
     except (OSError, UnicodeDecodeError, csv.Error) as exc:
         raise InputError(f"cannot read history {name!r}: {exc}") from None
-    rows = [(n, [c.strip() for c in row]) for n, row in lines if row and any(c.strip() for c in row)
-            and not row[0].lstrip().startswith("#")]
+    rows = [
+        (n, [c.strip() for c in row])
+        for n, row in lines
+        if row and any(c.strip() for c in row) and not row[0].lstrip().startswith("#")
+    ]
     if not rows:
         raise InputError(f"{name}: empty file (expected a header row time,depth or time,force)")
     header_line, header = rows[0]
     if len(header) != 2 or header[0] != "time" or header[1] not in CONTROLS:
-        raise InputError(f"{name}:{header_line}: header must be 'time,depth' or 'time,force' (got {','.join(header)!r})")
+        raise InputError(
+            f"{name}:{header_line}: header must be 'time,depth' or 'time,force' (got {','.join(header)!r})"
+        )
     control = header[1]
     if len(rows) < 2:
         raise InputError(f"{name}: no samples after the header")
@@ -63,7 +68,9 @@ def read_history(path: str | Path) -> History:
                 raise InputError(f"{name}:{line}: column {column!r} must be finite (got {row[j]!r})")
             values[i, j] = number
         if i and values[i, 0] <= values[i - 1, 0]:
-            raise InputError(f"{name}:{line}: column 'time' must increase strictly ({row[0]} after {values[i - 1, 0]!r})")
+            raise InputError(
+                f"{name}:{line}: column 'time' must increase strictly ({row[0]} after {values[i - 1, 0]!r})"
+            )
     return History(values[:, 0].copy(), control, values[:, 1].copy())
 
 
@@ -71,12 +78,14 @@ def write_result(path: str | Path, result: HistoryResult) -> None:
     """Write `result` as CSV: header of column names, one row per sample (bools as 0/1)."""
     columns = result.columns()
     names = list(columns)
-    rows = zip(*(columns[n].tolist() for n in names))
+    rows = zip(*(columns[n].tolist() for n in names), strict=True)
     try:
         with open(path, "w", newline="", encoding="utf-8") as handle:
             writer = csv.writer(handle)
             writer.writerow(names)
             for row in rows:
-                writer.writerow([int(v) if isinstance(v, bool) else repr(v) if isinstance(v, float) else v for v in row])
+                writer.writerow(
+                    [int(v) if isinstance(v, bool) else repr(v) if isinstance(v, float) else v for v in row]
+                )
     except OSError as exc:
         raise InputError(f"cannot write {str(path)!r}: {exc}") from None
