@@ -113,10 +113,10 @@ def main() -> None:
     finger = {
         "contact": contact.id,
         "grip_depth": 4.0 * d_c,
-        "speed": 5.0 * d_c / (2.5 * creep),  # press in 2.5 creep times
-        "hold": creep,
+        "speed": 5.0 * d_c / (0.5 * creep),  # a quick grasp: half a creep time
+        "hold": 0.5 * creep,
         "release_speeds": [0.5 * d_c / creep, 5.0 * d_c / creep, 50.0 * d_c / creep],
-        "max_pull": 0.8 * slow_pull_off,  # the arm may pull 80 % of the slow limit
+        "max_pull": 1.2 * slow_pull_off,  # what the arm may pull without losing the object
     }
     # --8<-- [end:setup]
 

@@ -15,9 +15,9 @@ from pathlib import Path
 import numpy as np
 import yaml
 from geometry_msgs.msg import PointStamped, WrenchStamped
-from viscoadh_ros.core.history import simulate_history
 
 from viscoadh_ros.core.config import SceneConfig, default_scene_path
+from viscoadh_ros.core.history import simulate_history
 from viscoadh_ros.demo import creep_time
 from viscoadh_ros.io.mcap_log import McapRecorder
 from viscoadh_ros.plotting import JkrReference
@@ -34,7 +34,7 @@ def cycle(d_c: float, ramp: float, hold: float, dt: float) -> np.ndarray:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", type=Path, default=Path("experiment"))
-    parser.add_argument("--samples", type=int, default=400, help="samples per slow ramp")
+    parser.add_argument("--samples", type=int, default=100, help="samples per slow ramp")
     args = parser.parse_args()
 
     # The "true" material: the built-in scene with a stiffer, stickier pad.

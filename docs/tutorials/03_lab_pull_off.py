@@ -16,9 +16,9 @@ import matplotlib
 matplotlib.use("Agg")  # files only, no window
 import matplotlib.pyplot as plt
 import numpy as np
-from viscoadh_ros.core.history import predict_pull_off
 
 from viscoadh_ros.core.config import SceneConfig, default_scene_path
+from viscoadh_ros.core.history import predict_pull_off
 from viscoadh_ros.core.simulator import ContactSimulator
 from viscoadh_ros.demo import creep_time
 from viscoadh_ros.plotting import JkrReference
