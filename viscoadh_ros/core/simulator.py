@@ -565,16 +565,20 @@ class ContactSimulator:
         """Hold the last control (the current depth) until `time` (s)."""
         return self.step(time, depth=self._depth)
 
+    def _trial(self, time: float, depth: float) -> tuple[float, float, float]:
+        """Advance the model (only) from the current state to (time, depth); returns
+        (radius m, force N, work J). An idle contact above the surface costs nothing."""
+        if self.is_idle and depth < 0.0 and self._depth < 0.0:
+            if isinstance(self._model, _TimeStepped):
+                self._model.drop_memory()
+            return 0.0, 0.0, 0.0
+        return self._model.advance(self._depth, depth, time - self._time)
+
     def _move(self, time: float, depth: float, *, unstable: bool) -> StepOutput:
         """Advance the model from the current state to (time, depth) and publish the output."""
         dt = time - self._time
         r0 = self._output.contact_radius
-        if self.is_idle and depth < 0.0 and self._depth < 0.0:
-            radius, force, work = 0.0, 0.0, 0.0
-            if isinstance(self._model, _TimeStepped):
-                self._model.drop_memory()
-        else:
-            radius, force, work = self._model.advance(self._depth, depth, dt)
+        radius, force, work = self._trial(time, depth)
         self._energy_input += work
         self._time, self._depth = time, depth
         self._output = self._make_output(time, depth, force, r0, radius, dt, unstable)
@@ -619,6 +623,10 @@ class ContactSimulator:
         )
 
     # -- force control ----------------------------------------------------------------------
+    def _attached(self) -> bool:
+        """Whether the model's current (possibly trial) state is in contact."""
+        return self._model.radius > 0.0
+
     def _stiffness_guess(self) -> float:
         """A contact stiffness scale, N/m, to size the first bracketing step."""
         radius = self._output.contact_radius
@@ -641,14 +649,15 @@ class ContactSimulator:
         was_in_contact = self.in_contact
 
         def residual(depth: float) -> float:
-            self.restore(start)
-            return self._move(time, depth, unstable=False).force - target
+            self._model.set_state(start.model_state)
+            return self._trial(time, depth)[1] - target
 
         r_hold = residual(d0)
         if abs(r_hold) <= tol:
-            return self._output
+            self.restore(start)
+            return self._move(time, d0, unstable=False)
         direction = 1.0 if r_hold < 0.0 else -1.0
-        if direction < 0.0 and not self.in_contact and not was_in_contact:
+        if direction < 0.0 and not self._attached() and not was_in_contact:
             # Out of contact and pulled away: no equilibrium, the indenter stays off.
             self.restore(start)
             return self._move(time, d0, unstable=target < 0.0)
@@ -660,16 +669,17 @@ class ContactSimulator:
             r_hi = residual(hi)
             if r_hi * direction >= 0.0:
                 break
-            if direction < 0.0 and not self.in_contact:
+            if direction < 0.0 and not self._attached():
                 found = self._search_dip(residual, hi, last_contact)
                 if found is None:
-                    return self._pulled_off(residual, hi, last_contact, time)
+                    return self._pulled_off(residual, hi, last_contact, time, start)
                 hi, r_hi = found
                 break
             last_contact = hi
             lo = hi
             delta *= 2.0
         else:
+            self.restore(start)
             raise InputError(f"force {target!r} N cannot be reached from depth {d0!r} m")
         root = brentq(
             residual,
@@ -680,13 +690,12 @@ class ContactSimulator:
             maxiter=200,
         )
         r_root = residual(root)
-        jumped_in = not was_in_contact and self.in_contact and self.physics.work_of_adhesion > 0.0
-        if abs(r_root) > max(tol, 1e-9 * abs(target)) or jumped_in:
-            # The force jumped across the target (snap-in or a discontinuous edge): no
-            # continuous equilibrium path; keep the physical state reached.
-            self.restore(start)
-            self._move(time, root, unstable=True)
-        return self._output
+        jumped_in = not was_in_contact and self._attached() and self.physics.work_of_adhesion > 0.0
+        # A residual left at the root means the force jumped across the target (snap-in or
+        # a discontinuous edge): no continuous equilibrium path; keep the state reached.
+        unstable = abs(r_root) > max(tol, 1e-9 * abs(target)) or jumped_in
+        self.restore(start)
+        return self._move(time, root, unstable=unstable)
 
     def _search_dip(self, residual, detached: float, attached: float) -> tuple[float, float] | None:
         """Between an attached and a detached trial depth, look for a force below the target
@@ -695,7 +704,7 @@ class ContactSimulator:
         for _ in range(60):
             mid = 0.5 * (lo + hi)
             r_mid = residual(mid)
-            if not self.in_contact:
+            if not self._attached():
                 lo = mid
             else:
                 hi = mid
@@ -721,20 +730,20 @@ class ContactSimulator:
                 break
         return None
 
-    def _pulled_off(self, residual, detached: float, attached: float, time: float) -> StepOutput:
+    def _pulled_off(
+        self, residual, detached: float, attached: float, time: float, start: Snapshot
+    ) -> StepOutput:
         """No equilibrium under force control: move to the detached state at the depth where
         the contact let go, flagged unstable."""
         lo, hi = detached, attached
         for _ in range(60):
             mid = 0.5 * (lo + hi)
             residual(mid)
-            if self.in_contact:
+            if self._attached():
                 hi = mid
             else:
                 lo = mid
             if hi - lo <= 1e-13 * max(abs(hi), abs(lo), 1e-300):
                 break
-        residual(lo)
-        output = self._output
-        self._output = StepOutput(**{**output.__dict__, "unstable": True})
-        return self._output
+        self.restore(start)
+        return self._move(time, lo, unstable=True)
