@@ -4,7 +4,8 @@ A `NumericsConfig` (core/config.py) names a preset and may override single knobs
 "take the preset's value"). `resolve_numerics` turns it into the concrete numbers the
 simulator uses. `balanced` is the default and meets the accuracy targets of the test
 suite (Hertz/Sneddon within 0.5 %, JKR within 1 % of the peak force, standard-solid pull-off
-within 2 %); `fast` trades about a factor 3 of accuracy for speed, `accurate` the reverse.
+within 2 %); `fast` uses fewer elements and coarser edge substeps, `accurate` more and
+finer (measure the trade with `viscoadh bench`).
 
 Knobs:
 - elements: N, elements of the 1D MDR row over the domain (0, L].

@@ -385,11 +385,6 @@ class _TimeStepped:
             if status == _kernels.STATUS_OK:
                 break
             self.set_state(start)
-            if self.row is None:
-                self.row = self._build_row(
-                    self.initial_length or 1.25 * float(self.physics.profile.radius_at_height(max(d0, d1))),
-                    None,
-                )
             self._grow()
             start = self.get_state()
         self.radius = float(out[_kernels.OUT_RADIUS])
