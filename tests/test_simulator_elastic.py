@@ -189,3 +189,55 @@ def test_model_choice_and_override() -> None:
     assert ContactSimulator(viscous).model == "time_stepped"
     with pytest.raises(ConfigError, match="numerics.model"):
         ContactSimulator(make_contact(sphere, model="closed_form", kelvin=(1e5,), viscosities=(1e3,)))
+
+
+@pytest.mark.parametrize(
+    "indenter",
+    [
+        {"shape": "power_law", "coefficient": 30.0, "exponent": 1.5},
+        {"shape": "cone", "half_angle": 1.45},
+    ],
+)
+def test_adhesive_cycle_paths_agree(indenter: dict) -> None:
+    """Adhesive elastic cycle of a power-law and a cone indenter: the time-stepped path lands
+    on the closed form (which is exact for these shapes)."""
+    work = 0.05
+    closed = ContactSimulator(make_contact(indenter, work=work, model="closed_form"))
+    stepped = ContactSimulator(make_contact(indenter, work=work, model="time_stepped"))
+    depth = np.concatenate([np.linspace(-1e-7, 1e-6, 60), np.linspace(1e-6, -2e-6, 150)[1:]])
+    a = [closed.step((i + 1) * 1e-3, depth=float(d)) for i, d in enumerate(depth)]
+    b = [stepped.step((i + 1) * 1e-3, depth=float(d)) for i, d in enumerate(depth)]
+    peak = max(abs(o.force) for o in a)
+    np.testing.assert_allclose(
+        [o.force for o in b],
+        [o.force for o in a],
+        rtol=0,
+        atol=1e-2 * peak,
+        err_msg=f"{indenter['shape']}: time-stepped vs closed form",
+    )
+    assert [o.phase == Phase.NO_CONTACT for o in a] == [o.phase == Phase.NO_CONTACT for o in b]
+
+
+def test_tabulated_sphere_follows_hertz_and_jkr() -> None:
+    """A sphere given as a table of f(r) samples (time-stepped path) against the closed forms."""
+    r = np.linspace(0.0, 2e-4, 401)
+    table = {"shape": "table", "table_radius": r.tolist(), "table_height": (r**2 / (2 * R)).tolist()}
+    sim = ContactSimulator(make_contact(table, work=0.05))
+    assert sim.model == "time_stepped"
+    for i, d in enumerate(np.linspace(0.0, 5e-6, 11)[1:]):
+        out = sim.step((i + 1) * 1e-3, depth=float(d))
+        np.testing.assert_allclose(
+            out.force,
+            reference.jkr_force(out.contact_radius, R, E0, 0.05),
+            rtol=0,
+            atol=5e-3 * abs(reference.jkr_pull_off_force_control(R, E0, 0.05).force),
+            err_msg=f"table d={d}",
+        )
+        np.testing.assert_allclose(
+            out.depth,
+            reference.jkr_depth(out.contact_radius, R, E0, 0.05),
+            rtol=1e-2,
+            atol=1e-9,
+            err_msg=f"table d={d}",
+        )
+    assert sim.output.effective_work_of_adhesion == pytest.approx(0.05, rel=1e-2)
