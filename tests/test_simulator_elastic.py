@@ -73,13 +73,14 @@ def test_sneddon_cone(model: str) -> None:
 
 
 @pytest.mark.parametrize("model", MODELS)
-def test_flat_punch_stiffness(model: str) -> None:
+@pytest.mark.parametrize("punch", [R, 7.3e-4, 1.3e-2])
+def test_flat_punch_stiffness(model: str, punch: float) -> None:
     depth = np.concatenate([np.linspace(0.0, 1e-6, 11), np.linspace(1e-6, 2e-7, 5)[1:]])
-    _, outputs = run_depth(make_contact({"shape": "flat_punch", "radius": R}, model=model), depth)
+    _, outputs = run_depth(make_contact({"shape": "flat_punch", "radius": punch}, model=model), depth)
     stiffness = np.array([o.force / o.depth for o in outputs if o.depth > 0.0])
-    expected = reference.flat_punch_stiffness(R, E0)
-    np.testing.assert_allclose(stiffness, expected, rtol=2e-3, err_msg=f"punch stiffness {model}")
-    assert all(o.contact_radius == pytest.approx(R, rel=1e-12) for o in outputs if o.depth > 0.0), model
+    expected = reference.flat_punch_stiffness(punch, E0)
+    np.testing.assert_allclose(stiffness, expected, rtol=2e-3, err_msg=f"punch a0={punch} stiffness {model}")
+    assert all(o.contact_radius == pytest.approx(punch, rel=1e-12) for o in outputs if o.depth > 0.0), model
 
 
 def _jkr_cycle(work: float) -> tuple[np.ndarray, float]:

@@ -159,7 +159,9 @@ def _scan_out(x_start, d, wsum, lo, hi, dx, g_c, gf, df, c_crit, reach):
     prev = x_start
     while j < m:
         xj = j * df
-        if xj >= reach:
+        # A domain that ends at the reach (flat punch: L = a0) must not ask to grow
+        # because the last fine point fell a rounding error short of it.
+        if xj >= reach * (1.0 - 1e-12):
             if _h(reach, d, wsum, lo, hi, dx, g_c, gf, df, c_crit, 0.0) >= 0.0:
                 return reach, False
             return _bisect(prev, reach, d, wsum, lo, hi, dx, g_c, gf, df, c_crit, 0.0), False
