@@ -124,7 +124,8 @@ def stored_energy(row: _kernels.Row, radius: float, depth: float, points: int = 
 
 
 def locate_edge(row: _kernels.Row, radius: float, depth: float, points: int = 400001) -> float:
-    """New contact radius by the energy criterion on a dense grid (see `_locate_edge`)."""
+    """New contact radius by the energy criterion on a dense grid (see `_locate_edge`):
+    first touch, else detachment, else attachment."""
     x = np.linspace(0.0, row.length, points)
     reach = min(row.reach, row.length)
     x = x[x <= reach]
@@ -138,11 +139,7 @@ def locate_edge(row: _kernels.Row, radius: float, depth: float, points: int = 40
         start = x[touching[0]]
         h = gap(row, x, depth, 0.0, interior=False)
         return _outward(x, h, start, reach)
-    h_out = gap(row, np.array([radius]), depth, radius, interior=False)[0]
-    if radius < reach and h_out > 0.0:
-        return _outward(x, gap(row, x, depth, radius, interior=False), radius, reach)
-    h_in = gap(row, np.array([radius]), depth, radius, interior=True)[0]
-    if h_in < 0.0:
+    if gap(row, np.array([radius]), depth, radius, interior=True)[0] < 0.0:  # detachment first
         h = gap(row, x, depth, radius, interior=True)
         below = np.flatnonzero((x < radius) & (h >= 0.0))
         if below.size == 0:
@@ -152,6 +149,8 @@ def locate_edge(row: _kernels.Row, radius: float, depth: float, points: int = 40
         return float(
             x[j] + (x_hi - x[j]) * h[j] / (h[j] - gap(row, np.array([x_hi]), depth, radius, True)[0])
         )
+    if radius < reach and gap(row, np.array([radius]), depth, radius, interior=False)[0] > 0.0:
+        return _outward(x, gap(row, x, depth, radius, interior=False), radius, reach)
     return radius
 
 

@@ -127,6 +127,27 @@ def test_edge_location_matches_dense_search(chain: str, radius: float, depth: fl
     )
 
 
+def test_detachment_wins_when_both_criteria_hold() -> None:
+    """Interior over-stretched and exterior memory inviting attachment at the same edge:
+    the interior lets go (numba and reference agree, and the edge recedes)."""
+    row = make_row("standard")
+    radius, depth = 8e-5, 1.5e-6
+    n_in = naive.interior_count(radius, row.dx, row.elements)
+    memory = np.zeros_like(row.wl)
+    memory[:n_in] = 4e-6  # crept interior: pushes its glass springs into tension
+    memory[n_in:] = -4e-6  # exterior raised towards the indenter
+    row.set_memory(memory)
+    assert _kernels.criterion_gap(row, radius, depth, radius, interior=True) < 0.0
+    assert _kernels.criterion_gap(row, radius, depth, radius, interior=False) > 0.0
+    new_radius, motion, _ = _kernels._locate_edge(
+        radius, depth, row.wsum, row.dx, row.g_c, row.gf, row.df, row.c_crit, row.reach, row.kap
+    )
+    assert motion == _kernels.MOTION_DETACH and new_radius < radius
+    np.testing.assert_allclose(
+        new_radius, naive.locate_edge(row, radius, depth), rtol=0, atol=1e-5 * row.length
+    )
+
+
 def test_advance_without_edge_motion_is_the_exact_chain_update() -> None:
     """One `advance` over a step in which the edge stays put: chains updated exactly, force
     and work consistent with the force kernel."""

@@ -192,11 +192,10 @@ def _locate_edge(a, d, wsum, dx, g_c, gf, df, c_crit, reach, kap):
                     return 0.0, MOTION_NONE, False
                 return radius, MOTION_ATTACH, grow
         return 0.0, MOTION_NONE, False
-    # Attachment of exterior elements, judged with the exterior (residual) memory.
-    if a < reach and _h(a, d, wsum, n_in, n - 1, dx, g_c, gf, df, c_crit, 0.0) > 0.0:
-        radius, grow = _scan_out(a, d, wsum, n_in, n - 1, dx, g_c, gf, df, c_crit, reach)
-        return radius, MOTION_ATTACH, grow
-    # Detachment of interior elements, judged with the interior (crept) memory.
+    # Detachment of interior elements, judged with the interior (crept) memory. It goes
+    # first: an over-stretched interior edge cannot hold, whatever the memory outside says.
+    # (Elements that just let go sit at the attachment threshold; the other order lets the
+    # discretised exterior memory re-attach them and the receding edge chatter.)
     if _h(a, d, wsum, 0, n_in - 1, dx, g_c, gf, df, c_crit, kap) < 0.0:
         j = int(a / df)
         if j * df >= a:
@@ -210,6 +209,10 @@ def _locate_edge(a, d, wsum, dx, g_c, gf, df, c_crit, reach, kap):
             upper = xj
             j -= 1
         return 0.0, MOTION_DETACH, False
+    # Attachment of exterior elements, judged with the exterior (residual) memory.
+    if a < reach and _h(a, d, wsum, n_in, n - 1, dx, g_c, gf, df, c_crit, 0.0) > 0.0:
+        radius, grow = _scan_out(a, d, wsum, n_in, n - 1, dx, g_c, gf, df, c_crit, reach)
+        return radius, MOTION_ATTACH, grow
     return a, MOTION_NONE, False
 
 
@@ -472,6 +475,30 @@ def _advance(
     out[OUT_MOTION] = motion
     out[OUT_SUBSTEPS] = substeps
     return STATUS_OK
+
+
+@numba.njit(cache=True)
+def _remap(wl, a, d, dx, g_c, gf, df, steady, new_dx, out):
+    """Kelvin state of a regridded row (element width new_dx) into ``out`` (N', K).
+
+    Each new centre takes the memory of its own side of the edge, interpolated exactly as
+    the force and criterion see it (`_w_side`): interpolating across the edge would smear
+    the interior/exterior jump that is the sticking zone. Beyond the old domain nothing was
+    ever touched: zero memory.
+    """
+    n, k_count = wl.shape
+    n_in = _interior_count(a, dx, n)
+    length = n * dx
+    for i in range(out.shape[0]):
+        x = (i + 0.5) * new_dx
+        interior = a > 0.0 and (x < a or i == 0)
+        lo, hi = (0, n_in - 1) if interior else (n_in, n - 1)
+        for k in range(k_count):
+            if x > length:
+                out[i, k] = 0.0
+            else:
+                coef = steady[k] if interior else 0.0
+                out[i, k] = _w_side(x, wl[:, k], lo, hi, dx, coef, d, g_c, gf, df)
 
 
 @numba.njit(cache=True)
@@ -768,6 +795,28 @@ def kelvin_update(row: Row, n_in: int, d0: float, d1: float, dt: float) -> None:
     )
 
 
+def remap_memory(row: Row, radius: float, depth: float, elements: int, length: float) -> np.ndarray:
+    """The Kelvin state of `row` (contact radius m, depth m) on a new grid of `elements`
+    over (0, length], shape (elements, K); see `_remap`."""
+    _check_scalars(radius=radius, depth=depth, length=length)
+    if elements < 1 or not length > 0.0:
+        raise ValueError(f"need elements >= 1 and length > 0 (got {elements}, {length!r})")
+    out = np.empty((int(elements), row.wl.shape[1]))
+    _remap(
+        row.wl,
+        float(radius),
+        float(depth),
+        row.dx,
+        row.g_c,
+        row.gf,
+        row.df,
+        row.steady,
+        float(length) / elements,
+        out,
+    )
+    return out
+
+
 def warm_up() -> None:
     """Compile (or load from cache) and call every kernel once on a tiny row, so the first
     real step does not stall (about 0.2 s even from the on-disk cache)."""
@@ -798,3 +847,4 @@ def warm_up() -> None:
     stored_energy(row, 0.3, 0.1)
     criterion_gap(row, 0.3, 0.1, 0.3, interior=True)
     kelvin_update(row, 2, 0.0, 0.1, 0.01)
+    remap_memory(row, 0.3, 0.1, 3, 2.0)

@@ -123,10 +123,11 @@ class _Physics:
         return bool(scale_separation_holds(edge_speed, self.critical_speeds))
 
     def adhesion_length(self) -> float:
-        """Contact radius of the relaxed JKR contact at zero depth with the detachment-side
-        effective work (``w (E0*/E_r*)``), m: the natural domain scale of an adhesive scene."""
-        w_eff = self.work_of_adhesion * self.e0 / self.e_relaxed
-        c = math.sqrt(2.0 * math.pi * w_eff / self.e_relaxed)
+        """First-touch neck radius, m: the root of ``g(x) = dl_c(x)`` (JKR at zero depth with
+        the glass modulus), where an adhesive contact starts. Domains start from it and grow:
+        a larger scale (say the relaxed detachment JKR radius, G0/G_inf times larger in
+        ``w_eff``) would leave the neck inside one element for large G0/G_inf."""
+        c = self.c_crit
         x = (
             max(self.profile.characteristic_radius, 1e-30)
             if math.isfinite(self.profile.characteristic_radius)
@@ -336,18 +337,15 @@ class _TimeStepped:
             c_crit=self.physics.c_crit,
         )
 
-    def _grow(self) -> None:
-        """Grow the domain, remapping the memory (zero beyond the old domain: never touched)."""
+    def _grow(self, depth: float) -> None:
+        """Grow the domain, remapping the memory side by side of the edge (`remap_memory`)
+        at the current depth (m)."""
         row = self.row
         assert row is not None
         length = row.length * self.numerics.growth_factor
         if length > 1e6 * max(self.initial_length, 1e-300) and length > 1e3:
             raise InputError("the contact grows without bound (adhesion beats the profile's rise)")
-        centres = (np.arange(row.elements) + 0.5) * row.dx
-        new_centres = (np.arange(row.elements) + 0.5) * (length / row.elements)
-        memory = np.empty_like(row.wl)
-        for k in range(row.wl.shape[1]):
-            memory[:, k] = np.interp(new_centres, centres, row.wl[:, k], right=0.0)
+        memory = _kernels.remap_memory(row, self.radius, depth, row.elements, length)
         self.row = self._build_row(length, memory)
 
     def _ensure_row(self, depth: float) -> bool:
@@ -385,7 +383,7 @@ class _TimeStepped:
             if status == _kernels.STATUS_OK:
                 break
             self.set_state(start)
-            self._grow()
+            self._grow(d0)
             start = self.get_state()
         self.radius = float(out[_kernels.OUT_RADIUS])
         self.substeps = int(out[_kernels.OUT_SUBSTEPS])
