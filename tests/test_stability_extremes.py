@@ -154,13 +154,6 @@ def assert_dissipation_never_negative(contact: Any, jumps: np.ndarray, step: flo
     assert np.all(np.diff(dissipated) >= -tol), f"{case}: dissipation decreases"
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="simulator bug (G0/G1 >= 1e4, adhesive): touching at zero depth gives a force of "
-    "-0.075 N where the instant neck gives about -(4/3) pi R w = -4.2e-3 N, and negative "
-    "dissipation (energy created); suspected cause: the domain is sized from the detachment "
-    "adhesion length (w G0/G_relaxed), leaving the first-touch neck inside one element",
-)
 def test_touch_at_zero_depth_huge_glass_ratio() -> None:
     """Touching at zero depth and holding, G0/G1 = 1e4: dissipation must stay >= 0."""
     glass = 1e6
