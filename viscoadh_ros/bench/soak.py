@@ -28,8 +28,14 @@ def logged_commands(log_path: Path) -> int:
     return sum(bag.message_count(topic) for topic in bag.topics if topic.endswith("/indentation"))
 
 
-def soak(*, minutes: float, contacts: int = SOAK_CONTACTS, rate_hz: float = SOAK_RATE_HZ) -> dict[str, Any]:
-    """The `soak` results section (see the module docstring)."""
+def soak(
+    *,
+    minutes: float,
+    contacts: int = SOAK_CONTACTS,
+    rate_hz: float = SOAK_RATE_HZ,
+    domain_id: int | None = None,
+) -> dict[str, Any]:
+    """The `soak` results section (see the module docstring); `domain_id` None picks one."""
     duration = minutes * 60.0
     with tempfile.TemporaryDirectory(prefix="viscoadh_soak_") as tmp:
         log_path = Path(tmp) / "soak.mcap"
@@ -43,6 +49,7 @@ def soak(*, minutes: float, contacts: int = SOAK_CONTACTS, rate_hz: float = SOAK
             depth_amplitude=amplitude,
             scene_path=scene_path,
             warmup_s=WARMUP_S,
+            domain_id=domain_id,
         )
         logged = logged_commands(log_path)
     measured = trips.rss_time_s >= trips.startup_s + WARMUP_S

@@ -23,6 +23,8 @@ class Plan:
     accuracy_elements: tuple[int, ...]
     accuracy_rows: tuple[int, ...]
     accuracy_repeats: int
+    reference_elements: int
+    reference_rows: int
     preset_rows: int
     node_contacts: int
     node_duration_s: float
@@ -35,9 +37,11 @@ FULL = Plan(
     kernel_kelvin=(0, 1, 4),
     kernel_steps=2000,
     kernel_repeats=7,
-    accuracy_elements=(32, 64, 128, 256, 512, 1024),
+    accuracy_elements=(32, 64, 128, 256, 512),
     accuracy_rows=(251, 1001, 4001),
-    accuracy_repeats=3,
+    accuracy_repeats=2,
+    reference_elements=1024,
+    reference_rows=4001,
     preset_rows=1001,
     node_contacts=4,
     node_duration_s=30.0,
@@ -47,11 +51,13 @@ FULL = Plan(
 QUICK = Plan(
     kernel_elements=(64, 256, 1024, 4096),
     kernel_kelvin=(0, 1, 4),
-    kernel_steps=500,
+    kernel_steps=200,
     kernel_repeats=3,
     accuracy_elements=(64, 256),
     accuracy_rows=(251, 1001),
     accuracy_repeats=1,
+    reference_elements=512,
+    reference_rows=2001,
     preset_rows=1001,
     node_contacts=4,
     node_duration_s=5.0,
@@ -101,7 +107,7 @@ def run(
         from viscoadh_ros.core.presets import PRESET_NAMES
 
         progress("accuracy: reference runs")
-        references = reference_forces()
+        references = reference_forces(elements=plan.reference_elements, rows=plan.reference_rows)
         progress("accuracy: grid over elements and steps")
         results["accuracy"] = accuracy_grid(
             references=references,

@@ -1,0 +1,232 @@
+"""`viscoadh bench` runs on tiny sizes and produces well-formed output (never a timing assert)."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+from viscoadh_ros.bench import accuracy, kernel, report, suite
+from viscoadh_ros.bench.latency import measure_round_trips, summarize_node_latency
+from viscoadh_ros.bench.timing import interleaved_medians, latency_summary
+from viscoadh_ros.cli.main import main as cli_main
+
+TINY = dataclasses.replace(
+    suite.QUICK,
+    kernel_elements=(32,),
+    kernel_kelvin=(0, 1),
+    kernel_steps=10,
+    kernel_repeats=1,
+    accuracy_elements=(16,),
+    accuracy_rows=(51,),
+    reference_elements=32,
+    reference_rows=101,
+    preset_rows=51,
+)
+
+
+def assert_finite_numbers(row: dict[str, Any], case: str) -> None:
+    for key, value in row.items():
+        if isinstance(value, float):
+            assert math.isfinite(value), f"{case}: {key} = {value}"
+
+
+def test_pareto_front_keeps_only_undominated_points() -> None:
+    points = [
+        {"us_per_step": 1.0, "rel_error": 0.1},
+        {"us_per_step": 2.0, "rel_error": 0.2},  # dominated by the first
+        {"us_per_step": 3.0, "rel_error": 0.01},
+        {"us_per_step": 4.0, "rel_error": 0.01},  # same error, dearer
+    ]
+    assert accuracy.pareto_front(points) == [points[0], points[2]]
+
+
+def test_timing_helpers_validate_and_summarise() -> None:
+    assert set(interleaved_medians({"a": lambda: None, "b": lambda: None}, repeats=3)) == {"a", "b"}
+    with pytest.raises(ValueError, match="repeats"):
+        interleaved_medians({"a": lambda: None}, repeats=0)
+    summary = latency_summary([1e-3] * 99 + [1e-2], prefix="x")
+    np.testing.assert_allclose(summary["x_p50_ms"], 1.0, rtol=1e-12, err_msg="median of the sample")
+    with pytest.raises(ValueError, match="no round trips"):
+        latency_summary([], prefix="x")
+
+
+def test_bare_loop_reads_and_writes_every_element_once_per_step() -> None:
+    """The floor loop against a plain-numpy version of the same update."""
+    rng = np.random.default_rng(1)
+    wl, g_c, depth = rng.random((8, 3)), rng.random(8), rng.random(5)
+    wsum = np.zeros(8)
+    expected_wl = wl.copy()
+    for d in depth:
+        u = d - g_c
+        expected_wl = 0.5 * expected_wl + 1e-3 * u[:, None]
+        expected_wsum = expected_wl.sum(axis=1) + 1e-3 * u
+    kernel._bare_steps(wl, wsum, g_c, depth)
+    np.testing.assert_allclose(wl, expected_wl, rtol=1e-12, err_msg="bare loop state")
+    np.testing.assert_allclose(wsum, expected_wsum, rtol=1e-12, err_msg="bare loop sums")
+
+
+@pytest.mark.parametrize("kelvin", [0, 1, 4])
+def test_kernel_row_is_well_formed(kelvin: int) -> None:
+    row = kernel.measure_kernel(32, kelvin, steps=10, repeats=1)
+    assert row["elements"] == 32 and row["kelvin"] == kelvin
+    assert_finite_numbers(row, f"K={kelvin}")
+    assert row["ns_per_element_step"] > 0 and row["baseline_ns_per_element_step"] > 0
+    np.testing.assert_allclose(
+        row["ratio"],
+        row["ns_per_element_step"] / row["baseline_ns_per_element_step"],
+        rtol=1e-12,
+        err_msg=f"ratio of K={kelvin}",
+    )
+    assert row["substeps_per_step"] >= 1.0
+
+
+def test_accuracy_cases_use_the_closed_forms() -> None:
+    by_name = {case.name: case for case in accuracy.cases()}
+    jkr = by_name["jkr_pull_off"]
+    np.testing.assert_allclose(
+        jkr.exact_pull_off,
+        -1.5 * math.pi * accuracy.RADIUS * accuracy.WORK_OF_ADHESION,
+        rtol=1e-12,
+        err_msg="elastic JKR pull-off",
+    )
+    enhanced = (
+        accuracy.WORK_OF_ADHESION
+        * (accuracy.GLASS_MODULUS + accuracy.KELVIN_MODULUS)
+        / accuracy.KELVIN_MODULUS
+    )
+    np.testing.assert_allclose(
+        by_name["standard_solid_pull_off"].exact_pull_off,
+        -1.5 * math.pi * accuracy.RADIUS * enhanced,
+        rtol=1e-12,
+        err_msg="standard-solid quasistatic pull-off with w_eff2",
+    )
+    assert by_name["rate_dependent"].exact_pull_off is None
+
+
+def test_quick_cli_writes_json_report_and_figure(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The verb end to end on tiny sizes: JSON keys, Markdown sections, figure file."""
+    monkeypatch.setattr(suite, "QUICK", TINY)
+    json_path, output = tmp_path / "out" / "results.json", tmp_path / "BENCH.md"
+    status = cli_main(
+        [
+            "bench",
+            "--quick",
+            "--sections",
+            "kernel,accuracy",
+            "--json",
+            str(json_path),
+            "--output",
+            str(output),
+        ]
+    )
+    assert status == 0, capsys.readouterr().err
+    results = json.loads(json_path.read_text())
+    assert results["command"] == (
+        f"viscoadh bench --quick --json {json_path} --output {output} --sections kernel,accuracy"
+    )
+    assert [(r["elements"], r["kelvin"]) for r in results["kernel"]] == [(32, 0), (32, 1)]
+    assert {r["case"] for r in results["accuracy"]} == {c.name for c in accuracy.cases()}
+    assert {r["preset"] for r in results["presets"]} == {"fast", "balanced", "accurate"}
+    for row in results["accuracy"] + results["presets"]:
+        assert set(row) >= {"preset", "elements", "time_step", "case", "rel_error", "us_per_step"}
+        assert_finite_numbers(row, f"{row['case']} {row['preset']}")
+        assert row["rel_error"] >= 0.0
+    text = output.read_text()
+    for heading in ("## Kernel", "## Accuracy", "## Fidelity presets", "## Stability"):
+        assert heading in text, f"{heading} missing from the report"
+    assert "](out/accuracy_pareto.png)" in text
+    assert (tmp_path / "out" / "accuracy_pareto.png").stat().st_size > 0
+
+
+def test_unknown_section_exits_2_with_one_line(capsys: pytest.CaptureFixture[str]) -> None:
+    assert cli_main(["bench", "--sections", "kernel,warp"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "unknown warp" in err
+
+
+def test_non_positive_soak_is_a_usage_error(capsys: pytest.CaptureFixture[str]) -> None:
+    with pytest.raises(SystemExit) as raised:
+        cli_main(["bench", "--soak", "-1"])
+    assert raised.value.code == 2
+    assert "--soak must be > 0 minutes" in capsys.readouterr().err
+
+
+def test_echo_round_trips_all_come_back(ros_env: dict[str, str]) -> None:
+    """Echo server and client in child processes: every command's echo is matched by stamp."""
+    trips = measure_round_trips(
+        "echo",
+        contact_ids=["a", "b"],
+        duration_s=0.5,
+        rate_hz=100.0,
+        depth_amplitude=1e-5,
+        domain_id=int(ros_env["ROS_DOMAIN_ID"]),
+        warmup_s=0.2,
+    )
+    assert trips.latency_s.size == 100
+    assert trips.dropped == 0, "echoes lost or mismatched"
+    assert np.all(trips.latency_s > 0.0)
+    assert np.all(np.diff(trips.send_time_s) >= 0.0)
+    assert trips.startup_s > 0.0
+    summary = summarize_node_latency(trips, trips, rate_hz=100.0)
+    np.testing.assert_allclose(summary["p99_ratio"], 1.0, rtol=1e-12, err_msg="ratio of a run to itself")
+
+
+def test_soak_on_the_node_reports_memory_drops_and_log(ros_env: dict[str, str]) -> None:
+    """A tiny soak: the node in a child process with logging on answers with states."""
+    from viscoadh_ros.bench.soak import soak
+
+    result = soak(minutes=0.02, contacts=1, rate_hz=50.0, domain_id=int(ros_env["ROS_DOMAIN_ID"]))
+    assert result["commands_sent"] == 60
+    assert result["dropped"] < result["commands_sent"], "no state came back from the node"
+    assert result["logged_commands"] >= result["commands_sent"] - result["dropped"]
+    assert result["rss_start_mb"] > 0.0
+    assert_finite_numbers(result, "soak")
+
+
+def test_replay_speed_reports_stage_shares() -> None:
+    from viscoadh_ros.bench.replay_speed import replay_benchmark
+
+    result = replay_benchmark(seconds=0.1, repeats=1)
+    assert result["commands"] == 100
+    assert result["realtime_factor"] > 0.0
+    assert set(result["time_share"]) == {"decode", "simulate", "encode and compare"}
+    assert all(0.0 <= share <= 1.0 for share in result["time_share"].values())
+
+
+def test_report_marks_targets() -> None:
+    """Rendering alone, on results shaped like a run's: targets met and missed are marked."""
+    results = {
+        "command": "viscoadh bench",
+        "date": "today",
+        "machine": "test",
+        "node": {
+            "contacts": 4,
+            "rate_hz": 1000.0,
+            "duration_s": 30.0,
+            "latency_p50_ms": 1.0,
+            "latency_p99_ms": 2.0,
+            "latency_p999_ms": 3.0,
+            "echo_p50_ms": 0.5,
+            "echo_p99_ms": 1.0,
+            "echo_p999_ms": 2.0,
+            "p99_ratio": 2.0,
+            "deadline_miss_fraction": 0.5,
+            "echo_deadline_miss_fraction": 0.0,
+            "dropped": 3,
+            "echo_dropped": 0,
+            "client_send_lag_p99_ms": 0.1,
+            "startup_s": 1.0,
+            "echo_startup_s": 0.5,
+            "commands_sent": 100,
+        },
+    }
+    text = report.render_markdown(results, None)
+    assert "p99 ratio 2 (target <= 1.25): **missed**" in text
