@@ -5,6 +5,7 @@
 A full run writes BENCHMARKS.md (tables, with the accuracy figure under the JSON's folder) and
 benchmarks/results.json; `--quick` (under about three minutes) writes only what is asked for
 with --json/--output and prints a summary. Each file records the command line that made it.
+A hand-written `notes.md` beside the JSON (causes of missed targets) is copied into the report.
 """
 
 from __future__ import annotations
@@ -20,6 +21,8 @@ from pathlib import Path
 DEFAULT_OUTPUT = Path("BENCHMARKS.md")
 DEFAULT_JSON = Path("benchmarks/results.json")
 FIGURE_NAME = "accuracy_pareto.png"
+# Hand-written analysis beside the JSON, copied into the report on every run.
+NOTES_NAME = "notes.md"
 
 
 def _positive_minutes(text: str) -> float:
@@ -139,6 +142,8 @@ def main(args: argparse.Namespace) -> int:
     if output is not None:
         link = Path(os.path.relpath(figure, output.parent)) if figure is not None else None
         output.parent.mkdir(parents=True, exist_ok=True)
-        output.write_text(report.render_markdown(results, link), encoding="utf-8")
+        notes_path = (json_path or DEFAULT_JSON).parent / NOTES_NAME
+        notes = notes_path.read_text(encoding="utf-8") if notes_path.is_file() else None
+        output.write_text(report.render_markdown(results, link, notes), encoding="utf-8")
     print(_summary(results))
     return 0
