@@ -212,8 +212,11 @@ def test_force_control_creeps_under_constant_load() -> None:
     # Long-time limit: Hertz with the relaxed modulus.
     e_r = CreepElement.from_config(make_contact().material).relaxed_modulus_star
     relaxed_depth = (3e-3 / (4 * e_r * math.sqrt(R))) ** (2 / 3)
-    out = sim.step(100.0, force=1e-3)
+    out = sim.advance(100.0)  # holds the last control: the force
+    np.testing.assert_allclose(out.force, 1e-3, rtol=1e-5, err_msg="advance holds the force")
     np.testing.assert_allclose(out.depth, relaxed_depth, rtol=2e-3, err_msg="relaxed creep depth")
+    held = sim.step(101.0, depth=out.depth).depth
+    assert sim.advance(200.0).depth == held, "advance after a depth command holds the depth"
 
 
 def test_bad_input_names_the_parameter_and_changes_nothing() -> None:

@@ -470,6 +470,7 @@ class Snapshot:
     depth: float
     output: StepOutput
     energy_input: float
+    held_force: float | None
 
 
 class ContactSimulator:
@@ -521,13 +522,21 @@ class ContactSimulator:
         self._time = require_finite("time", time)
         self._depth = 0.0
         self._energy_input = 0.0
+        self._held_force: float | None = None
         self._model.reset()
         self._output = StepOutput(
             self._time, 0.0, 0.0, 0.0, Phase.NO_CONTACT, 0.0, 0.0, 0.0, 0.0, True, False
         )
 
     def snapshot(self) -> Snapshot:
-        return Snapshot(self._model.get_state(), self._time, self._depth, self._output, self._energy_input)
+        return Snapshot(
+            self._model.get_state(),
+            self._time,
+            self._depth,
+            self._output,
+            self._energy_input,
+            self._held_force,
+        )
 
     def restore(self, snapshot: Snapshot) -> None:
         self._model.set_state(snapshot.model_state)
@@ -535,6 +544,7 @@ class ContactSimulator:
         self._depth = snapshot.depth
         self._output = snapshot.output
         self._energy_input = snapshot.energy_input
+        self._held_force = snapshot.held_force
 
     # -- stepping -------------------------------------------------------------------------
     def _check_time(self, time: float) -> float:
@@ -551,11 +561,19 @@ class ContactSimulator:
             raise InputError("step needs exactly one of depth or force")
         if depth is not None:
             d = require_finite("depth", depth)
-            return self._move(t, d, unstable=False)
-        return self._solve_force(t, require_finite("force", force))
+            output = self._move(t, d, unstable=False)
+            self._held_force = None
+            return output
+        target = require_finite("force", force)
+        output = self._solve_force(t, target)
+        self._held_force = target
+        return output
 
     def advance(self, time: float) -> StepOutput:
-        """Hold the last control (the current depth) until `time` (s)."""
+        """Hold the last control until `time` (s): the last commanded force under force
+        control (the indenter creeps), else the current depth."""
+        if self._held_force is not None:
+            return self.step(time, force=self._held_force)
         return self.step(time, depth=self._depth)
 
     def _trial(self, time: float, depth: float) -> tuple[float, float, float]:
