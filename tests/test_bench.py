@@ -144,6 +144,11 @@ def test_quick_cli_writes_json_report_and_figure(
         assert heading in text, f"{heading} missing from the report"
     assert "](out/accuracy_pareto.png)" in text
     assert (tmp_path / "out" / "accuracy_pareto.png").stat().st_size > 0
+    # Re-rendering from the JSON (after editing notes.md) measures nothing and keeps the tables.
+    (tmp_path / "out" / "notes.md").write_text("## Notes\n\nA cause.\n")
+    rendered = tmp_path / "RENDERED.md"
+    assert cli_main(["bench", "--render", str(json_path), "--output", str(rendered)]) == 0
+    assert rendered.read_text() == text.replace("## Kernel", "## Notes\n\nA cause.\n\n## Kernel", 1)
 
 
 def test_unknown_section_exits_2_with_one_line(capsys: pytest.CaptureFixture[str]) -> None:

@@ -50,6 +50,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="also run the node for MINUTES under 1 kHz on 8 contacts with logging on",
     )
     parser.add_argument(
+        "--render",
+        type=Path,
+        metavar="RESULTS_JSON",
+        help="measure nothing: rewrite the report (--output, default BENCHMARKS.md) from a results JSON",
+    )
+    parser.add_argument(
         "--sections",
         default=",".join(SECTIONS),
         help=f"comma-separated sections to run (default: all of {','.join(SECTIONS)})",
@@ -105,8 +111,23 @@ def _command_line(args: argparse.Namespace, sections: list[str]) -> str:
     return shlex.join(words)
 
 
+def _write_report(results: dict, json_path: Path, output: Path) -> None:
+    """BENCHMARKS.md at `output`, its figure and notes (if any) beside `json_path`."""
+    from viscoadh_ros.bench import report
+
+    figure = None
+    if "accuracy" in results:
+        figure = json_path.parent / FIGURE_NAME
+        report.accuracy_figure(results, figure)
+    link = Path(os.path.relpath(figure, output.parent)) if figure is not None else None
+    notes_path = json_path.parent / NOTES_NAME
+    notes = notes_path.read_text(encoding="utf-8") if notes_path.is_file() else None
+    output.parent.mkdir(parents=True, exist_ok=True)
+    output.write_text(report.render_markdown(results, link, notes), encoding="utf-8")
+
+
 def main(args: argparse.Namespace) -> int:
-    from viscoadh_ros.bench import report, suite
+    from viscoadh_ros.bench import suite
 
     sections = [s.strip() for s in args.sections.split(",") if s.strip()]
     unknown = sorted(set(sections) - set(suite.SECTIONS))
@@ -117,6 +138,16 @@ def main(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
         return 2
+    if args.render is not None:
+        try:
+            results = json.loads(args.render.read_text(encoding="utf-8"))
+        except (OSError, ValueError) as exc:
+            print(
+                f"viscoadh bench: error: --render: cannot read {str(args.render)!r}: {exc}", file=sys.stderr
+            )
+            return 2
+        _write_report(results, args.render, args.output or DEFAULT_OUTPUT)
+        return 0
     json_path = args.json if args.json is not None or args.quick else DEFAULT_JSON
     output = args.output if args.output is not None or args.quick else DEFAULT_OUTPUT
     command = _command_line(args, sections)
@@ -131,19 +162,10 @@ def main(args: argparse.Namespace) -> int:
     except RuntimeError as exc:
         print(f"viscoadh bench: error: {exc}", file=sys.stderr)
         return 1
-    figure = None
-    if output is not None and "accuracy" in results:
-        figure_dir = (json_path or DEFAULT_JSON).parent
-        figure = figure_dir / FIGURE_NAME
-        report.accuracy_figure(results, figure)
     if json_path is not None:
         json_path.parent.mkdir(parents=True, exist_ok=True)
         json_path.write_text(json.dumps(results, indent=2) + "\n", encoding="utf-8")
     if output is not None:
-        link = Path(os.path.relpath(figure, output.parent)) if figure is not None else None
-        output.parent.mkdir(parents=True, exist_ok=True)
-        notes_path = (json_path or DEFAULT_JSON).parent / NOTES_NAME
-        notes = notes_path.read_text(encoding="utf-8") if notes_path.is_file() else None
-        output.write_text(report.render_markdown(results, link, notes), encoding="utf-8")
+        _write_report(results, json_path or DEFAULT_JSON, output)
     print(_summary(results))
     return 0
