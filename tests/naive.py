@@ -64,11 +64,10 @@ def side_values(
     row: _kernels.Row, x: np.ndarray, values: np.ndarray, lo: int, hi: int, coef: float, depth: float
 ) -> np.ndarray:
     """`_kernels._w_side` vectorised: interpolate ``values - coef u`` over elements lo..hi,
-    linear extrapolation towards the edge, hold at the centre and the far end."""
+    linear extrapolation below lo (exterior towards the edge), hold elsewhere."""
     x = np.asarray(x, dtype=np.float64)
     if lo > hi:
         return np.zeros_like(x)
-    n = values.size
     idx = np.arange(lo, hi + 1)
     dev = values[idx] - coef * (depth - row.g_c[idx])
     p = x / row.dx - 0.5
@@ -76,9 +75,6 @@ def side_values(
     if lo > 0 and hi > lo:
         below = dev[0] + (p - lo) * (dev[1] - dev[0])
         inside = np.where(p <= lo, below, inside)
-    if hi < n - 1 and hi > lo:
-        above = dev[-1] + (p - hi) * (dev[-1] - dev[-2])
-        inside = np.where(p >= hi, above, inside)
     return coef * (depth - g_at(row, x)) + inside
 
 
