@@ -126,9 +126,7 @@ def _sequence(typecode: str, values: Any) -> array.array:
     return sequence
 
 
-def history_response(
-    result: HistoryResult, response: SimulateHistory.Response
-) -> SimulateHistory.Response:
+def history_response(result: HistoryResult, response: SimulateHistory.Response) -> SimulateHistory.Response:
     """Fill ``response`` from a history result (one value per request sample)."""
     response.depth = _sequence("d", result.depth)
     response.force = _sequence("d", result.force)

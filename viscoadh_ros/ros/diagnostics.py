@@ -77,9 +77,7 @@ def contact_status(
     if not scale_separation_ok:
         problems.append("scale separation of the energy criterion violated")
     if counters.rejections_in_window:
-        problems.append(
-            f"{counters.rejections_in_window} rejected (last: {counters.last_rejection})"
-        )
+        problems.append(f"{counters.rejections_in_window} rejected (last: {counters.last_rejection})")
     counters.rejections_in_window = 0
     values = {
         "model": model,
@@ -102,9 +100,7 @@ def contact_status(
     )
 
 
-def diagnostic_array(
-    statuses: list[DiagnosticStatus], *, stamp_ns: int
-) -> DiagnosticArray:
+def diagnostic_array(statuses: list[DiagnosticStatus], *, stamp_ns: int) -> DiagnosticArray:
     """The /diagnostics message holding ``statuses``, stamped on the node clock."""
     msg = DiagnosticArray(status=statuses)
     msg.header.stamp = ns_to_stamp(stamp_ns)

@@ -20,9 +20,7 @@ if TYPE_CHECKING:
 _DISC_THICKNESS = 0.02
 
 
-def _marker(
-    kind: int, marker_id: int, namespace: str, stamp_ns: int, frame_id: str
-) -> Marker:
+def _marker(kind: int, marker_id: int, namespace: str, stamp_ns: int, frame_id: str) -> Marker:
     marker = Marker(type=kind, id=marker_id, ns=namespace, action=Marker.ADD)
     marker.header.stamp = ns_to_stamp(stamp_ns)
     marker.header.frame_id = frame_id
