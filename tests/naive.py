@@ -64,7 +64,8 @@ def side_values(
     row: _kernels.Row, x: np.ndarray, values: np.ndarray, lo: int, hi: int, coef: float, depth: float
 ) -> np.ndarray:
     """`_kernels._w_side` vectorised: interpolate ``values - coef u`` over elements lo..hi,
-    linear extrapolation below lo (exterior towards the edge), hold elsewhere."""
+    linear extrapolation below lo (exterior towards the edge), minmod-limited linear
+    extrapolation above hi (interior towards the edge), hold at the centre and far end."""
     x = np.asarray(x, dtype=np.float64)
     if lo > hi:
         return np.zeros_like(x)
@@ -75,6 +76,12 @@ def side_values(
     if lo > 0 and hi > lo:
         below = dev[0] + (p - lo) * (dev[1] - dev[0])
         inside = np.where(p <= lo, below, inside)
+    if hi < values.size - 1 and hi > lo:
+        slope = dev[-1] - dev[-2]
+        if hi - 2 >= lo:
+            before = dev[-2] - dev[-3]
+            slope = 0.0 if slope * before <= 0.0 else min(slope, before, key=abs)
+        inside = np.where(p >= hi, dev[-1] + (p - hi) * slope, inside)
     return coef * (depth - g_at(row, x)) + inside
 
 

@@ -103,11 +103,13 @@ def _w_side(x, values, lo, hi, dx, coef, d, g_c, gf, df):
     ``2 E0* int (u - w)``, would carry the interpolation error of w amplified by
     ``E0*/E_r*`` (sign flips at G0/G1 = 1e3).
 
-    Beyond its last element the interior holds its deviation (exact when relaxed, and a
-    freshly attached element cannot throw the extrapolation into a detach/attach
-    flip-flop). The exterior is extrapolated linearly towards the edge from its first two
-    elements: an element that just let go then sits at the attachment threshold instead of
-    above it. At the centre (symmetry) and the far end (no memory) values are held.
+    Beyond its last element the interior extrapolates its deviation linearly with the
+    minmod of its last two slopes: exact for a relaxed (v = 0) or glassy (v = -coef u)
+    interior, while a freshly attached last element cannot steer the slope into a
+    detach/attach flip-flop (a plain hold is first-order wrong for a glassy edge). The
+    exterior is extrapolated linearly towards the edge from its first two elements: an
+    element that just let go then sits at the attachment threshold instead of above it.
+    At the centre (symmetry) and the far end (no memory) values are held.
     """
     if lo > hi:
         return 0.0
@@ -120,7 +122,15 @@ def _w_side(x, values, lo, hi, dx, coef, d, g_c, gf, df):
         v_next = values[lo + 1] - coef * (d - g_c[lo + 1])
         return base + v_lo + (p - lo) * (v_next - v_lo)
     if p >= hi:
-        return base + values[hi] - coef * (d - g_c[hi])
+        v_hi = values[hi] - coef * (d - g_c[hi])
+        if hi == lo or hi == values.shape[0] - 1:
+            return base + v_hi
+        slope = v_hi - (values[hi - 1] - coef * (d - g_c[hi - 1]))
+        if hi - 2 >= lo:
+            # minmod limiter: a freshly attached last element must not steer the slope.
+            before = values[hi - 1] - coef * (d - g_c[hi - 1]) - (values[hi - 2] - coef * (d - g_c[hi - 2]))
+            slope = 0.0 if slope * before <= 0.0 else (slope if abs(slope) < abs(before) else before)
+        return base + v_hi + (p - hi) * slope
     i = int(p)
     t = p - i
     v_i = values[i] - coef * (d - g_c[i])
