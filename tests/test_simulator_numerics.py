@@ -16,7 +16,7 @@ from viscoadh_ros.core.simulator import ContactSimulator
 def test_presets_order_cost_and_overrides_apply() -> None:
     fast, balanced, accurate = (preset(name) for name in PRESET_NAMES)
     assert fast.elements < balanced.elements < accurate.elements
-    assert fast.max_edge_cells >= balanced.max_edge_cells >= accurate.max_edge_cells
+    assert fast.max_edge_cells >= balanced.max_edge_cells >= accurate.max_edge_cells > 0.0
     assert fast.force_tolerance > balanced.force_tolerance > accurate.force_tolerance
     assert resolve_numerics(NumericsConfig()) == balanced
     tuned = resolve_numerics(

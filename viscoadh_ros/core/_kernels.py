@@ -45,7 +45,7 @@ OUT_SIZE = 5
 # Substep attempts per `advance` after which the edge-motion limit is dropped for the rest of
 # the step: a guard (never reached in the test suite) so that an edge criterion flipping back
 # and forth at any step size cannot stall a node; the step still completes exactly in time.
-_MAX_ATTEMPTS = 20000
+_MAX_ATTEMPTS = 2000
 
 # Below this |lambda dt| the phi functions use their Taylor series: the closed forms lose
 # all digits to cancellation there (1 - exp(-x) for x ~ 1e-12).

@@ -55,7 +55,7 @@ class ResolvedNumerics:
 _PRESETS = {
     "fast": ResolvedNumerics("fast", "auto", 64, 16, 2.0, 0.0, 1e-4, 0.0, 2.0, 1e-9),
     "balanced": ResolvedNumerics("balanced", "auto", 160, 32, 1.0, 0.0, 1e-6, 0.0, 2.0, 1e-10),
-    "accurate": ResolvedNumerics("accurate", "auto", 400, 32, 0.5, 0.0, 1e-8, 0.0, 1.5, 1e-12),
+    "accurate": ResolvedNumerics("accurate", "auto", 400, 32, 1.0, 0.0, 1e-8, 0.0, 1.5, 1e-12),
 }
 
 
