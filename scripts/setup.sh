@@ -4,7 +4,8 @@
 #   2. install the pinned requirements (ROS 2 Jazzy wheels, numerics, test tools),
 #   3. point the ROS wheels' exported CMake include paths at this venv,
 #   4. build msg_defs (viscoadh_msgs) with plain CMake and install it into the venv,
-#   5. install this package (editable) so the repository code is what runs.
+#   5. install this package (editable) so the repository code is what runs,
+#   6. compile the numba kernels into their on-disk cache.
 # Each step is skipped when a stamp file in .venv says its inputs (hashed) did not change, so a
 # re-run with nothing changed takes seconds. Environment: PYTHON (default python3.11),
 # VISCOADH_NO_LOCK=1 to resolve without requirements-lock.txt (only to regenerate the lock).
@@ -109,4 +110,9 @@ else
   [[ -x "$VENV/bin/viscoadh" ]] || die "$VENV/bin/viscoadh missing after install"
   stamp_set package "$pkg_hash"
 fi
+# 6. numba's on-disk cache -----------------------------------------------------------------
+# Compile every kernel once here (seconds when the cache is fresh), so the first node start or
+# test after a fresh clone does not spend ~10 s compiling inside a timeout.
+say "compiling the numba kernels (cached after the first time)"
+"$PY" -c 'from viscoadh_ros.core._kernels import warm_up; warm_up()' || die "numba kernels failed to compile"
 say "ready: $VENV/bin/viscoadh"
