@@ -5,11 +5,15 @@ Per contact id ``C`` of the scene: subscribes ``C/indentation``, publishes ``C/s
 ``C/predict_pull_off`` and ``C/reset``; node-wide it publishes ``/diagnostics`` at 1 Hz.
 The full interface with units and sign conventions is in docs/ros_interface.md.
 
-Threading: each contact's live path (command subscription and hold timer) is in its own
-mutually exclusive callback group, the services of all contacts in one reentrant group, and
-``main`` spins a MultiThreadedExecutor, so a long ``simulate_history`` never queues a command.
-A per-contact lock guards the simulator against the services and parameter changes, which run
-on other executor threads.
+Threading: the live path (every contact's command subscription and hold timer, and the state
+and wrench publishing they do) is served by the node's own thread on a raw rclpy wait set,
+started at the end of construction and stopped by ``destroy_node``. Its entities are in a
+callback group no executor runs (:class:`_LiveGroup`), so the executor the node is added to
+(``main`` spins a MultiThreadedExecutor in the main thread) serves only the services, parameter
+services, ``/clock`` and diagnostics: a 10^5-row ``simulate_history`` never queues a command,
+and rclpy's executor (tens of microseconds of Python per callback, measured as the bottleneck
+at 4 contacts x 1 kHz, see benchmarks/notes.md) is off the latency path. A per-contact lock
+guards the simulator against the services and parameter changes, which run on executor threads.
 """
 
 from __future__ import annotations
@@ -24,12 +28,16 @@ import rclpy
 from diagnostic_msgs.msg import DiagnosticArray
 from geometry_msgs.msg import WrenchStamped
 from rcl_interfaces.msg import SetParametersResult
-from rclpy.callback_groups import MutuallyExclusiveCallbackGroup, ReentrantCallbackGroup
+from rclpy.callback_groups import CallbackGroup, ReentrantCallbackGroup
 from rclpy.clock import JumpThreshold, TimeJump
 from rclpy.duration import Duration
+from rclpy.exceptions import InvalidHandle
 from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
+from rclpy.guard_condition import GuardCondition
+from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.node import Node
 from rclpy.parameter import Parameter
+from rosgraph_msgs.msg import Clock
 from std_srvs.srv import Trigger
 from viscoadh_msgs.msg import ContactState, IndentationCommand
 from viscoadh_msgs.srv import PredictPullOff, SimulateHistory
@@ -51,6 +59,9 @@ DIAGNOSTICS_PERIOD_S = 1.0
 #: Minimum interval between two warnings of the same kind of rejection (throttled log), s.
 WARN_THROTTLE_S = 1.0
 _QOS_DEPTH = 10
+#: GIL switch interval of the node process, s (CPython's default is 5 ms): how long the live
+#: thread, woken by a command, may wait for a service thread that holds the GIL in Python code.
+GIL_SWITCH_INTERVAL_S = 1e-4
 
 
 class Recorder(Protocol):
@@ -96,7 +107,7 @@ class _Contact:
         # a contact under force control creeps at constant force between commands.
         self.hold: dict[str, float] = {}
 
-        live = MutuallyExclusiveCallbackGroup()
+        live = node.live_group
         self.state_pub = node.create_publisher(ContactState, f"{self.id}/state", _QOS_DEPTH)
         self.wrench_pub = node.create_publisher(WrenchStamped, f"{self.id}/wrench", _QOS_DEPTH)
         self.marker_pub = node.create_publisher(Marker, f"{self.id}/marker", _QOS_DEPTH)
@@ -218,7 +229,7 @@ class _Contact:
             self.last_publish_ns = now_ns
             state = self._state_locked(output, now_ns)
         self._publish(state, output, now_ns, now_ns)
-        if self.node.markers_enabled:
+        if self.node.markers_enabled and self.marker_pub.get_subscription_count() > 0:
             for marker in markers.contact_markers(
                 output,
                 self.config.indenter,
@@ -239,11 +250,19 @@ class _Contact:
         )
 
     def _publish(self, state: ContactState, output: StepOutput, stamp_ns: int, now_ns: int) -> None:
-        wrench = conversions.wrench(output, stamp_ns=stamp_ns, frame_id=state.header.frame_id)
+        """Publish the state, and the wrench when it has subscribers; log what is published.
+
+        The wrench costs a message build and a publish per command (measured ~15% of the live
+        path): skipped while nobody reads it, except that an MCAP log keeps it for replays.
+        """
         self.state_pub.publish(state)
-        self.wrench_pub.publish(wrench)
         self.node.record(self.state_pub.topic_name, state, now_ns)
-        self.node.record(self.wrench_pub.topic_name, wrench, now_ns)
+        listened = self.wrench_pub.get_subscription_count() > 0
+        if listened or self.node.logging:
+            wrench = conversions.wrench(output, stamp_ns=stamp_ns, frame_id=state.header.frame_id)
+            if listened:
+                self.wrench_pub.publish(wrench)
+            self.node.record(self.wrench_pub.topic_name, wrench, now_ns)
 
     def _reject_locked(self, reason: str, *, command: bool) -> None:
         self.counters.reject(reason, command=command)
@@ -311,6 +330,14 @@ class _Contact:
         self.epoch_ns = None
         self.last_command_ns = None
 
+    def take_commands(self) -> None:
+        """Handle every command waiting on the subscription (live thread)."""
+        subscription = self.subscription
+        while (
+            taken := subscription.handle.take_message(subscription.msg_type, subscription.raw)
+        ) is not None:
+            self.on_command(taken[0])
+
     def set_publish_rate(self, rate: float) -> None:
         """Run the hold timer at ``rate`` Hz from now on."""
         self.timer.timer_period_ns = int(1e9 / rate)
@@ -325,6 +352,110 @@ class _Contact:
                 scale_separation_ok=bool(output.scale_separation_ok),
                 in_contact=self.simulator.in_contact,
             )
+
+
+class _LiveGroup(CallbackGroup):
+    """Callback group of the live path's entities: never run by an executor (the executors
+    leave out of their wait sets every entity whose group cannot execute), only by
+    :class:`_LiveLoop`."""
+
+    def can_execute(self, entity: Any) -> bool:
+        return False
+
+    def beginning_execution(self, entity: Any) -> bool:
+        return False
+
+    def ending_execution(self, entity: Any) -> None:
+        return None
+
+
+class _LiveLoop:
+    """The node's live thread: one raw wait set over every contact's command subscription and
+    hold timer, the node's ``/clock`` subscription (under ``use_sim_time``) and a guard
+    condition that stops it.
+
+    ``/clock`` is served here, before the commands taken in the same wake-up, so a command
+    received after a clock tick is handled on that tick's time, as on one executor; left to
+    the executor thread, the tick would race the command.
+
+    No executor: rclpy's Python executor builds a wait set, tasks and coroutines for every
+    callback; taking each message straight off its subscription costs a few microseconds. The
+    wait releases the GIL, so the thread costs nothing while no command arrives.
+    """
+
+    def __init__(self, node: ViscoadhNode) -> None:
+        self._node = node
+        self._contacts = list(node.contacts.values())
+        self._wake = GuardCondition(None, None, context=node.context)
+        self._stopping = False
+        self._wake_destroyed = False
+        self.error: BaseException | None = None
+        self._thread = threading.Thread(target=self._run, name="viscoadh-live", daemon=True)
+
+    def start(self) -> None:
+        self._thread.start()
+
+    def stop(self) -> None:
+        """Stop the thread and wait for it (idempotent)."""
+        self._stopping = True
+        if self._thread.is_alive():
+            self._wake.trigger()
+            self._thread.join()
+        if not self._wake_destroyed:
+            self._wake_destroyed = True
+            self._wake.destroy()
+
+    def _clock_subscription(self) -> Any:
+        """The node's ``/clock`` subscription, if ``use_sim_time`` made one, moved to this thread
+        (executors skip it from now on). rclpy creates and destroys it on the executor thread
+        when ``use_sim_time`` changes, so it is looked up on every wake-up."""
+        for subscription in self._node.subscriptions:
+            if subscription.msg_type is Clock:
+                subscription.callback_group = self._node.live_group
+                return subscription
+        return None
+
+    def _run(self) -> None:
+        contacts = self._contacts
+        wait_set = _rclpy.WaitSet(len(contacts) + 1, 1, len(contacts), 0, 0, 0, self._node.context.handle)
+        try:
+            while not self._stopping:
+                wait_set.clear_entities()
+                with contextlib.ExitStack() as in_use:
+                    clock = self._clock_subscription()
+                    if clock is not None:
+                        try:
+                            # Held while in the wait set: the executor thread may destroy it.
+                            in_use.enter_context(clock.handle)
+                            wait_set.add_subscription(clock.handle)
+                        except InvalidHandle:
+                            clock = None
+                    for contact in contacts:
+                        wait_set.add_subscription(contact.subscription.handle)
+                        wait_set.add_timer(contact.timer.handle)
+                    wait_set.add_guard_condition(self._wake.handle)
+                    wait_set.wait(-1)
+                    if self._stopping:
+                        return
+                    ready = wait_set.get_ready_entities("subscription")
+                    if clock is not None and clock.handle.pointer in ready:
+                        while (taken := clock.handle.take_message(Clock, clock.raw)) is not None:
+                            clock.callback(taken[0])
+                for contact in contacts:
+                    if contact.subscription.handle.pointer in ready:
+                        contact.take_commands()
+                ready = wait_set.get_ready_entities("timer")
+                for contact in contacts:
+                    if contact.timer.handle.pointer in ready:
+                        contact.timer.handle.call_timer()
+                        contact.on_timer()
+        except BaseException as error:
+            # Not a bad command (those are rejected in on_command): a bug or a dead context.
+            # Record it so main() stops the node rather than serve services without a live path.
+            if not self._stopping:
+                self.error = error
+                self._node.get_logger().fatal(f"live thread stopped: {error!r}")
+                raise
 
 
 class ViscoadhNode(Node):
@@ -348,6 +479,7 @@ class ViscoadhNode(Node):
         warm_up()
         warmed = time.perf_counter()
         self.services_group = ReentrantCallbackGroup()
+        self.live_group = _LiveGroup()
         self.contacts = {c.id: _Contact(self, c) for c in self.scene.contacts}
         self._jump_handler = self.get_clock().create_jump_callback(
             JumpThreshold(min_forward=None, min_backward=Duration(nanoseconds=-1)),
@@ -357,11 +489,23 @@ class ViscoadhNode(Node):
         self.add_on_set_parameters_callback(self._on_set_parameters)
         self.diagnostics_pub = self.create_publisher(DiagnosticArray, "/diagnostics", _QOS_DEPTH)
         self.create_timer(DIAGNOSTICS_PERIOD_S, self._publish_diagnostics)
+        self._live = _LiveLoop(self)
+        self._live.start()
         self.get_logger().info(
             f"ready in {time.perf_counter() - started:.3f} s (numba warm-up "
             f"{warmed - started:.3f} s); contacts: "
             + ", ".join(f"{c.id} [{c.simulator.model}]" for c in self.contacts.values())
         )
+
+    @property
+    def logging(self) -> bool:
+        """Whether an MCAP log is being written."""
+        return self._recorder is not None
+
+    @property
+    def live_error(self) -> BaseException | None:
+        """The exception that stopped the live thread, if one did (the node is then broken)."""
+        return self._live.error
 
     def now_ns(self) -> int:
         """Node clock (ROS time under ``use_sim_time``), ns."""
@@ -434,6 +578,8 @@ class ViscoadhNode(Node):
         return SetParametersResult(successful=True)
 
     def destroy_node(self) -> None:
+        # Stop the live thread first: it uses the subscriptions, timers and publishers.
+        self._live.stop()
         if self._recorder is not None:
             self._recorder.close()
             self._recorder = None
@@ -465,15 +611,23 @@ def _refuse(reason: str) -> SetParametersResult:
 def main(args: list[str] | None = None) -> int:
     """Run the node until Ctrl-C or shutdown (console script ``viscoadh_node``).
 
-    Returns 0, or 2 with one error line when the scene in the parameters is invalid.
+    The node's own thread serves the live path; the main thread spins a MultiThreadedExecutor
+    for services, parameters and diagnostics. Returns 0, 2 with one error line when the scene
+    in the parameters is invalid, 1 when the live thread failed.
     """
+    # A command should not wait up to CPython's default 5 ms for a busy service thread.
+    sys.setswitchinterval(GIL_SWITCH_INTERVAL_S)
     rclpy.init(args=args)
     node = None
     try:
         node = ViscoadhNode()
         executor = MultiThreadedExecutor()
         executor.add_node(node)
-        executor.spin()
+        while rclpy.ok() and node.live_error is None:
+            executor.spin_once(timeout_sec=0.5)
+        if node.live_error is not None:
+            print(f"viscoadh node: error: live path failed: {node.live_error!r}", file=sys.stderr, flush=True)
+            return 1
     except ConfigError as error:
         print(f"viscoadh node: error: {error}", file=sys.stderr, flush=True)
         return 2
