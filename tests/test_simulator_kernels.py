@@ -114,9 +114,7 @@ def test_force_energy_and_gap_match_dense_quadrature(chain: str, radius: float) 
 @pytest.mark.parametrize(("radius", "depth"), [(0.0, 2e-6), (5e-5, 1.5e-5), (1e-4, -1e-6), (8e-5, 2e-6)])
 def test_edge_location_matches_dense_search(chain: str, radius: float, depth: float) -> None:
     row = make_row(chain)
-    new_radius, _, grow = _kernels._locate_edge(
-        radius, depth, row.wsum, row.dx, row.g_c, row.gf, row.df, row.c_crit, row.reach, row.kap
-    )
+    new_radius, _, grow = _kernels.locate_edge(row, radius, depth)
     assert not grow
     np.testing.assert_allclose(
         new_radius,
@@ -139,9 +137,7 @@ def test_detachment_wins_when_both_criteria_hold() -> None:
     row.set_memory(memory)
     assert _kernels.criterion_gap(row, radius, depth, radius, interior=True) < 0.0
     assert _kernels.criterion_gap(row, radius, depth, radius, interior=False) > 0.0
-    new_radius, motion, _ = _kernels._locate_edge(
-        radius, depth, row.wsum, row.dx, row.g_c, row.gf, row.df, row.c_crit, row.reach, row.kap
-    )
+    new_radius, motion, _ = _kernels.locate_edge(row, radius, depth)
     assert motion == _kernels.MOTION_DETACH and new_radius < radius
     np.testing.assert_allclose(
         new_radius, naive.locate_edge(row, radius, depth), rtol=0, atol=1e-5 * row.length
@@ -184,3 +180,17 @@ def test_wrappers_reject_bad_input_before_numba() -> None:
 
 def test_warm_up_runs_every_kernel() -> None:
     _kernels.warm_up()
+
+
+@pytest.mark.parametrize("chain", ["standard", "three"])
+@pytest.mark.parametrize("seed", range(4))
+@pytest.mark.parametrize("depth", [-3e-6, -1e-6, 0.0, 1e-6])
+def test_first_touch_block_skip_finds_the_first_touching_fine_point(chain: str, seed: int, depth: float) -> None:
+    """The block-skipping first-touch search returns the same fine point as a point-by-point
+    scan of ``d - g - w >= 0`` (exterior memory interpolated as `naive.side_values`)."""
+    row = make_row(chain, seed=seed)
+    x = np.arange(row.gf.shape[0]) * row.df
+    touching = depth - row.gf - naive.side_values(row, x, row.wsum, 0, row.elements - 1, 0.0, depth) >= 0.0
+    expected = int(np.argmax(touching)) if touching.any() else -1
+    found = _kernels._first_touch(depth, row.wsum, row.dx, row.g_c, row.gf, row.gmin, row.df, row.reach)
+    assert found == expected, f"{chain} seed={seed} d={depth}: {found} != {expected}"

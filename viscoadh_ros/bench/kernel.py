@@ -49,16 +49,15 @@ def _bare_steps(wl, wsum, g_c, depth):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True)
-def _kernel_steps(head, radius, depth, dt, tail):  # pragma: no cover - compiled
+def _kernel_steps(row_args, radius, depth, dt, max_substep, max_edge_move):  # pragma: no cover - compiled
     """The simulator's kernel over a depth history; returns the total number of substeps.
 
-    head, tail: the kernel's arguments before the radius and after the step's (d0, d1, dt),
-    as `_kernels.advance` passes them (`out` last).
+    row_args: `Row.kernel_args`, the tuple the public wrapper `_kernels.advance` passes.
     """
-    out = tail[-1]
+    out = row_args[-1]
     substeps = 0
     for s in range(1, depth.shape[0]):
-        status = _kernels._advance(*head, radius, depth[s - 1], depth[s], dt, *tail)
+        status = _kernels._advance(*row_args, radius, depth[s - 1], depth[s], dt, max_substep, max_edge_move)
         if status != _kernels.STATUS_OK:
             return -1
         radius = out[_kernels.OUT_RADIUS]
@@ -115,32 +114,13 @@ def measure_kernel(elements: int, kelvin: int, *, steps: int, repeats: int) -> d
     numerics = simulator.numerics
     wl0 = row.wl.copy()
 
-    # The same arguments, in the same order, as the public wrapper `_kernels.advance` passes.
-    head = (row.wl, row.wsum, row.scratch)
-    tail = (
-        row.dx,
-        row.g_c,
-        row.gf,
-        row.gint,
-        row.df,
-        row.e0,
-        row.c_crit,
-        row.reach,
-        row.p,
-        row.p_inv,
-        row.lam,
-        row.beta,
-        row.rate,
-        row.kap,
-        float(numerics.max_substep),
-        float(numerics.max_edge_cells * row.dx),
-        row.out,
-    )
+    max_substep = float(numerics.max_substep)
+    max_edge_move = float(numerics.max_edge_cells * row.dx)
 
     def run_kernel() -> int:
         row.wl[...] = wl0
         row.wsum[...] = wl0.sum(axis=1)
-        return _kernel_steps(head, radius, depth, STEP_S, tail)
+        return _kernel_steps(row.kernel_args, radius, depth, STEP_S, max_substep, max_edge_move)
 
     def run_bare() -> None:
         _bare_steps(row.wl, row.wsum, row.g_c, depth)

@@ -51,6 +51,9 @@ _MAX_ATTEMPTS = 2000
 # all digits to cancellation there (1 - exp(-x) for x ~ 1e-12).
 _SERIES_LIMIT = 1e-4
 
+#: Fine points per block of the first-touch search (`_first_touch`, `Row.gmin`).
+TOUCH_BLOCK = 32
+
 
 @numba.njit(cache=True)
 def _phi(x: float) -> tuple:
@@ -185,25 +188,57 @@ def _scan_out(x_start, d, wsum, lo, hi, dx, g_c, gf, df, c_crit, reach):
 
 
 @numba.njit(cache=True)
-def _locate_edge(a, d, wsum, dx, g_c, gf, df, c_crit, reach, kap):
+def _first_touch(d, wsum, dx, g_c, gf, gmin, df, reach):
+    """First fine point (index) where the surface with its memory reaches the indenter,
+    ``d - g - w >= 0``, or -1 if none up to `reach`.
+
+    Out of contact with memory left this test runs every step, so whole blocks of
+    `TOUCH_BLOCK` fine points are skipped when a lower bound of ``g + w`` over the block
+    (`gmin` of the block, least memory value its interpolation uses) already rules out a
+    touch; the first touching point found is the same as a point-by-point scan."""
+    m = gf.shape[0]
+    n = wsum.shape[0]
+    for b in range(gmin.shape[0]):
+        j0 = b * TOUCH_BLOCK
+        j1 = min(j0 + TOUCH_BLOCK, m)
+        if j0 * df > reach:
+            return -1
+        # The elements `_w_side` interpolates between over this block, widened by one each
+        # side against the rounding of x/dx.
+        i0 = max(int(j0 * df / dx - 0.5) - 1, 0)
+        i1 = min(int((j1 - 1) * df / dx - 0.5) + 2, n - 1)
+        w_least = wsum[i0]
+        for i in range(i0 + 1, i1 + 1):
+            w_least = min(w_least, wsum[i])
+        # Margin: the interpolated w may undershoot its end values by a rounding error.
+        margin = 1e-12 * (abs(d) + abs(gmin[b]) + abs(w_least))
+        if d - gmin[b] - w_least < -margin:
+            continue
+        for j in range(j0, j1):
+            xj = j * df
+            if xj > reach:
+                return -1
+            if d - gf[j] - _w_side(xj, wsum, 0, n - 1, dx, 0.0, d, g_c, gf, df) >= 0.0:
+                return j
+    return -1
+
+
+@numba.njit(cache=True)
+def _locate_edge(a, d, wsum, dx, g_c, gf, gmin, df, c_crit, reach, kap):
     """Apply the energy criterion both ways at depth d. Returns (new radius, motion, grow)."""
     n = wsum.shape[0]
     n_in = _interior_count(a, dx, n)
     if a <= 0.0:
         # First touch needs the surface (with its memory) to reach the indenter somewhere;
         # the contact then covers the centre out to the attachment root.
-        m = gf.shape[0]
-        for j in range(m):
-            xj = j * df
-            if xj > reach:
-                break
-            if d - gf[j] - _w_side(xj, wsum, 0, n - 1, dx, 0.0, d, g_c, gf, df) >= 0.0:
-                radius, grow = _scan_out(xj, d, wsum, 0, n - 1, dx, g_c, gf, df, c_crit, reach)
-                if radius <= 0.0 and not grow:
-                    # Touching exactly at the apex without adhesion: no area, no contact.
-                    return 0.0, MOTION_NONE, False
-                return radius, MOTION_ATTACH, grow
-        return 0.0, MOTION_NONE, False
+        j = _first_touch(d, wsum, dx, g_c, gf, gmin, df, reach)
+        if j < 0:
+            return 0.0, MOTION_NONE, False
+        radius, grow = _scan_out(j * df, d, wsum, 0, n - 1, dx, g_c, gf, df, c_crit, reach)
+        if radius <= 0.0 and not grow:
+            # Touching exactly at the apex without adhesion: no area, no contact.
+            return 0.0, MOTION_NONE, False
+        return radius, MOTION_ATTACH, grow
     # Detachment of interior elements, judged with the interior (crept) memory. It goes
     # first: an over-stretched interior edge cannot hold, whatever the memory outside says.
     # (Elements that just let go sit at the attachment threshold; the other order lets the
@@ -398,14 +433,11 @@ def _advance(
     wl,
     wsum,
     scratch,
-    a,
-    d0,
-    d1,
-    dt,
     dx,
     g_c,
     gf,
     gint,
+    gmin,
     df,
     e0,
     c_crit,
@@ -416,11 +448,18 @@ def _advance(
     beta,
     rate,
     kap,
+    out,
+    a,
+    d0,
+    d1,
+    dt,
     max_substep,
     max_edge_move,
-    out,
 ):
     """Advance the row from depth d0 to d1 (linear in time) over dt with adaptive substeps.
+
+    Arguments: the row's arrays and constants as `Row.kernel_args` orders them, then the
+    step's scalars (radius a, d0, d1, dt, max_substep, max_edge_move).
 
     Substeps are halved while the edge would move more than ``max_edge_move`` (m) in one
     of them, down to ``1e-7 dt``: a true jump (snap-in, the fold at pull-off) is thereby
@@ -438,7 +477,7 @@ def _advance(
     substeps = 0
     attempts = 0
     if dt <= 0.0:
-        new_a, motion, grow = _locate_edge(a, d1, wsum, dx, g_c, gf, df, c_crit, reach, kap)
+        new_a, motion, grow = _locate_edge(a, d1, wsum, dx, g_c, gf, gmin, df, c_crit, reach, kap)
         if grow:
             return STATUS_GROW
         force_new = _force(new_a, d1, wsum, dx, g_c, gf, gint, df, e0, kap)
@@ -460,7 +499,7 @@ def _advance(
                 scratch[i, k] = wl[i, k]
         n_in = _interior_count(a, dx, n)
         _kelvin_update(wl, wsum, n_in, da, db, h, g_c, p, p_inv, lam, beta, rate)
-        new_a, sub_motion, grow = _locate_edge(a, db, wsum, dx, g_c, gf, df, c_crit, reach, kap)
+        new_a, sub_motion, grow = _locate_edge(a, db, wsum, dx, g_c, gf, gmin, df, c_crit, reach, kap)
         if grow:
             return STATUS_GROW
         attempts += 1
@@ -661,7 +700,35 @@ class Row:
         self.p, self.p_inv, self.lam, self.beta, self.rate = p, p_inv, lam, beta, rate
         self.e_kelvin, self.steady = e_kelvin, steady
         self.kap = float(steady.sum())
+        # Least profile height per block of TOUCH_BLOCK fine points (`_first_touch`).
+        self.gmin = np.minimum.reduceat(gf, np.arange(0, m, TOUCH_BLOCK))
         self.out = np.zeros(OUT_SIZE)
+
+    @property
+    def kernel_args(self) -> tuple:
+        """The row's arrays and constants in the order `_advance` takes them (before the
+        step's scalars); the benchmark calls the kernel with the same tuple."""
+        return (
+            self.wl,
+            self.wsum,
+            self.scratch,
+            self.dx,
+            self.g_c,
+            self.gf,
+            self.gint,
+            self.gmin,
+            self.df,
+            self.e0,
+            self.c_crit,
+            self.reach,
+            self.p,
+            self.p_inv,
+            self.lam,
+            self.beta,
+            self.rate,
+            self.kap,
+            self.out,
+        )
 
     @property
     def elements(self) -> int:
@@ -705,30 +772,7 @@ def advance(
     if dt < 0.0 or radius < 0.0 or max_edge_move <= 0.0 or not max_substep >= 0.0:
         raise ValueError("dt, radius and max_substep must be >= 0 and max_edge_move > 0")
     status = _advance(
-        row.wl,
-        row.wsum,
-        row.scratch,
-        float(radius),
-        float(d0),
-        float(d1),
-        float(dt),
-        row.dx,
-        row.g_c,
-        row.gf,
-        row.gint,
-        row.df,
-        row.e0,
-        row.c_crit,
-        row.reach,
-        row.p,
-        row.p_inv,
-        row.lam,
-        row.beta,
-        row.rate,
-        row.kap,
-        float(max_substep),
-        float(max_edge_move),
-        row.out,
+        *row.kernel_args, float(radius), float(d0), float(d1), float(dt), float(max_substep), float(max_edge_move)
     )
     return int(status), row.out
 
@@ -741,6 +785,16 @@ def force(row: Row, radius: float, depth: float) -> float:
             float(radius), float(depth), row.wsum, row.dx, row.g_c, row.gf, row.gint, row.df, row.e0, row.kap
         )
     )
+
+
+def locate_edge(row: Row, radius: float, depth: float) -> tuple[float, int, bool]:
+    """Apply the energy criterion both ways at `depth` (m) from contact radius `radius` (m):
+    ``(new radius m, MOTION_* code, grow)``; grow asks for a larger domain."""
+    _check_scalars(radius=radius, depth=depth)
+    new_radius, motion, grow = _locate_edge(
+        float(radius), float(depth), row.wsum, row.dx, row.g_c, row.gf, row.gmin, row.df, row.c_crit, row.reach, row.kap
+    )
+    return float(new_radius), int(motion), bool(grow)
 
 
 def stored_energy(row: Row, radius: float, depth: float) -> float:
