@@ -28,7 +28,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from viscoadh_ros.core.errors import InputError
-from viscoadh_ros.io.bag import Bag, RecordedMessage
+from viscoadh_ros.io import cdr
+from viscoadh_ros.io.bag import Bag
 
 if TYPE_CHECKING:
     from viscoadh_ros.core.config import ContactConfig, SceneConfig
@@ -77,32 +78,59 @@ class Experiment:
         return (int(last) - self.t0_ns) * 1e-9
 
 
-def _stamp_ns(message: RecordedMessage) -> int:
-    header = getattr(message.msg, "header", None)
-    if header is not None:
-        ns = header.stamp.sec * 1_000_000_000 + header.stamp.nanosec
-        if ns:
-            return ns
-    return message.log_time_ns
+#: The fields each type contributes: the input's value (and mode), or the measured force.
+_VALUE_FIELDS = {
+    COMMAND: ("mode", "depth", "force"),
+    FLOAT64: ("data",),
+    POINT: ("point.z",),
+    POSE: ("pose.position.z",),
+    WRENCH: ("wrench.force.z",),
+}
 
 
-def _input_of(message: RecordedMessage) -> tuple[int, float]:
-    msg = message.msg
-    if message.type_name == COMMAND:
-        if msg.mode not in (DEPTH, FORCE):
-            raise InputError(f"{message.topic}: IndentationCommand with unknown mode {msg.mode}")
-        return int(msg.mode), float(msg.depth if msg.mode == DEPTH else msg.force)
-    if message.type_name == FLOAT64:
-        return DEPTH, float(msg.data)
-    if message.type_name == POINT:
-        return DEPTH, float(msg.point.z)
-    return DEPTH, float(msg.pose.position.z)
+def _field(msg: Any, path: str) -> Any:
+    for name in path.split("."):
+        msg = getattr(msg, name)
+    return msg
 
 
-def _force_of(message: RecordedMessage) -> float:
-    if message.type_name == WRENCH:
-        return float(message.msg.wrench.force.z)
-    return float(message.msg.data)
+def _read_topic(bag: Bag, topic: str) -> tuple[NDArray[np.int64], NDArray[np.int64], dict[str, NDArray]]:
+    """``(stamp_ns, order, columns)`` of ``topic``: the time of each message (header stamp, or
+    the log time for a zero stamp or no header), its position in the recording, and the
+    :data:`_VALUE_FIELDS` of its type as arrays. Fixed-layout CDR is read in bulk; anything
+    else message by message through rclpy."""
+    type_name = bag.topics[topic]
+    log_ns, order, payloads = bag.raw(topic)
+    columns = cdr.decode(type_name, payloads)
+    if columns is None:
+        messages = list(bag.messages([topic]))
+        log_ns = np.array([m.log_time_ns for m in messages], dtype=np.int64)
+        order = np.array([m.order for m in messages], dtype=np.int64)
+        columns = {
+            path: np.array([_field(m.msg, path) for m in messages]) for path in _VALUE_FIELDS[type_name]
+        }
+        if messages and hasattr(messages[0].msg, "header"):
+            columns["stamp_ns"] = np.array(
+                [m.msg.header.stamp.sec * 1_000_000_000 + m.msg.header.stamp.nanosec for m in messages],
+                dtype=np.int64,
+            )
+    stamp_ns = columns.get("stamp_ns")
+    # A zero stamp means "on receipt": the log time.
+    stamps = log_ns if stamp_ns is None else np.where(stamp_ns != 0, stamp_ns, log_ns)
+    return stamps, order, columns
+
+
+def _inputs_of(topic: str, type_name: str, columns: dict[str, NDArray]) -> tuple[NDArray, NDArray]:
+    """``(mode, value)`` of every input message: DEPTH/FORCE and the depth (m) or force (N)."""
+    if type_name == COMMAND:
+        mode = columns["mode"].astype(np.uint8)
+        bad = np.flatnonzero((mode != DEPTH) & (mode != FORCE))
+        if bad.size:
+            raise InputError(f"{topic}: IndentationCommand with unknown mode {mode[bad[0]]}")
+        return mode, np.where(mode == DEPTH, columns["depth"], columns["force"]).astype(np.float64)
+    (path,) = _VALUE_FIELDS[type_name]
+    value = columns[path].astype(np.float64)
+    return np.full(value.size, DEPTH, dtype=np.uint8), value
 
 
 def _pick(
@@ -165,20 +193,24 @@ def load_experiment(
     )
     if forces == inputs:
         raise InputError(f"the input and the force topic are both {inputs!r}")
-    rows = [(_stamp_ns(m), m.order, *_input_of(m)) for m in bag.messages([inputs])]
-    if not rows:
+    stamps, order, columns = _read_topic(bag, inputs)
+    if stamps.size == 0:
         raise InputError(f"input topic {inputs!r} has no messages")
-    rows.sort(key=lambda row: row[:2])
-    input_ns = np.array([r[0] for r in rows], dtype=np.int64)
-    input_order = np.array([r[1] for r in rows], dtype=np.int64)
-    mode = np.array([r[2] for r in rows], dtype=np.uint8)
-    value = np.array([r[3] for r in rows], dtype=np.float64)
+    mode, value = _inputs_of(inputs, bag.topics[inputs], columns)
+    # By stamp; at equal stamps in recording order (see the module docstring).
+    by_time = np.lexsort((order, stamps))
+    input_ns, input_order, mode, value = stamps[by_time], order[by_time], mode[by_time], value[by_time]
     if not np.all(np.isfinite(value)):
         raise InputError(f"input topic {inputs!r} holds non-finite values")
-    measured = sorted((_stamp_ns(m), m.order, _force_of(m)) for m in bag.messages([forces])) if forces else []
-    measured_ns = np.array([m[0] for m in measured], dtype=np.int64)
-    measured_order = np.array([m[1] for m in measured], dtype=np.int64)
-    force = np.array([m[2] for m in measured], dtype=np.float64) * (-1.0 if flip_force else 1.0)
+    if forces:
+        measured_ns, measured_order, columns = _read_topic(bag, forces)
+        (path,) = _VALUE_FIELDS[bag.topics[forces]]
+        force = columns[path].astype(np.float64) * (-1.0 if flip_force else 1.0)
+        by_time = np.lexsort((measured_order, measured_ns))
+        measured_ns, measured_order, force = measured_ns[by_time], measured_order[by_time], force[by_time]
+    else:
+        measured_ns = measured_order = np.empty(0, dtype=np.int64)
+        force = np.empty(0)
     # Measured samples before the first input have no model to compare with.
     keep = measured_ns >= input_ns[0]
     if forces and not np.any(keep):

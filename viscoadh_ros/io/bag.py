@@ -1,7 +1,10 @@
 """Read ROS 2 recordings: one ``.mcap`` file or a rosbag2 folder (``metadata.yaml`` + ``*.mcap``).
 
 Messages are deserialised with :func:`rclpy.serialization.deserialize_message` into the
-installed message classes. A file that was not finished (a recorder killed mid-run) has no
+installed message classes, or read in bulk as raw CDR (:meth:`Bag.raw`) for the fixed-layout
+decoders of :mod:`viscoadh_ros.io.cdr`. Chunks are split into records here (one ``struct`` call
+per record) rather than by the ``mcap`` package's record objects, which cost several times
+more per message. A file that was not finished (a recorder killed mid-run) has no
 summary: it is read record by record up to the last complete chunk; :class:`Bag` refuses
 it with a clear :class:`InputError` unless ``recover=True``.
 """
@@ -11,13 +14,18 @@ from __future__ import annotations
 import struct
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
+from io import BytesIO
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import yaml
+from mcap.data_stream import ReadDataStream
 from mcap.exceptions import InvalidMagic, McapError
-from mcap.records import Channel, Footer, Message, Metadata, Schema
-from mcap.stream_reader import StreamReader
+from mcap.opcode import Opcode
+from mcap.records import Channel, Chunk, Footer, Message, Metadata, Schema
+from mcap.stream_reader import StreamReader, get_chunk_data_stream
+from numpy.typing import NDArray
 from rclpy.serialization import deserialize_message
 
 from viscoadh_ros.core.errors import InputError
@@ -42,7 +50,15 @@ class RecordedMessage:
 class _Topic:
     type_name: str
     encoding: str
-    raw: list[tuple[int, int, bytes]] = field(default_factory=list)  # (log time, order, CDR)
+    log_ns: list[int] = field(default_factory=list)  # log time of each message, ns
+    order: list[int] = field(default_factory=list)  # position in the recording
+    data: list[bytes] = field(default_factory=list)  # CDR payloads
+
+
+#: Record header (opcode u8, length u64) and Message record fields before the payload
+#: (channel id u16, sequence u32, log time u64, publish time u64), MCAP's little-endian layout.
+_RECORD_HEADER = struct.Struct("<BQ")
+_MESSAGE_FIELDS = struct.Struct("<HIQQ")
 
 
 def _bag_files(path: Path) -> list[Path]:
@@ -99,8 +115,10 @@ class Bag:
         finished = False
         with open(file, "rb") as stream:
             try:
-                for record in StreamReader(stream, validate_crcs=True).records:
-                    if isinstance(record, Schema):
+                for record in StreamReader(stream, emit_chunks=True, validate_crcs=True).records:
+                    if isinstance(record, Chunk):
+                        self._read_chunk(record, channels, schemas)
+                    elif isinstance(record, Schema):
                         schemas[record.id] = record
                     elif isinstance(record, Channel):
                         channels[record.id] = record
@@ -122,14 +140,53 @@ class Bag:
         if not finished:
             self.truncated.append(file)
 
-    def _add(self, record: Message, channels: dict[int, Channel], schemas: dict[int, Schema]) -> None:
-        channel = channels[record.channel_id]
+    def _read_chunk(self, chunk: Chunk, channels: dict[int, Channel], schemas: dict[int, Schema]) -> None:
+        """The records of one chunk (decompressed and CRC-checked by ``mcap``), in order."""
+        stream, length = get_chunk_data_stream(chunk, validate_crc=True)
+        data = memoryview(stream.read(length)) if length else memoryview(b"")
+        topics: dict[int, _Topic] = {}  # channel id -> topic, for this chunk's messages
+        position = 0
+        while position < length:
+            opcode, size = _RECORD_HEADER.unpack_from(data, position)
+            start = position + _RECORD_HEADER.size
+            position = start + size
+            if position > length:
+                raise McapError(f"chunk record of {size} bytes overruns its chunk")
+            if opcode == Opcode.MESSAGE:
+                channel_id, _, log_time, _ = _MESSAGE_FIELDS.unpack_from(data, start)
+                topic = topics.get(channel_id)
+                if topic is None:
+                    topic = topics[channel_id] = self._topic(channel_id, channels, schemas)
+                topic.log_ns.append(log_time)
+                topic.order.append(self._records)
+                topic.data.append(bytes(data[start + _MESSAGE_FIELDS.size : position]))
+                self._records += 1
+            elif opcode in (Opcode.CHANNEL, Opcode.SCHEMA):
+                body = ReadDataStream(BytesIO(data[start:position]))
+                if opcode == Opcode.CHANNEL:
+                    channel = Channel.read(body)
+                    channels[channel.id] = channel
+                else:
+                    schema = Schema.read(body)
+                    schemas[schema.id] = schema
+
+    def _topic(self, channel_id: int, channels: dict[int, Channel], schemas: dict[int, Schema]) -> _Topic:
+        """The topic of a channel, created on its first message."""
+        channel = channels.get(channel_id)
+        if channel is None:
+            raise McapError(f"message on channel {channel_id}, which is not defined before it")
         topic = self._topics.get(channel.topic)
         if topic is None:
             schema = schemas.get(channel.schema_id)
             type_name = schema.name if schema is not None else ""
             topic = self._topics[channel.topic] = _Topic(type_name, channel.message_encoding)
-        topic.raw.append((record.log_time, self._records, record.data))
+        return topic
+
+    def _add(self, record: Message, channels: dict[int, Channel], schemas: dict[int, Schema]) -> None:
+        topic = self._topic(record.channel_id, channels, schemas)
+        topic.log_ns.append(record.log_time)
+        topic.order.append(self._records)
+        topic.data.append(record.data)
         self._records += 1
 
     @property
@@ -139,7 +196,15 @@ class Bag:
 
     def message_count(self, topic: str) -> int:
         """Number of messages recorded on ``topic``."""
-        return len(self._topics[topic].raw)
+        return len(self._topics[topic].data)
+
+    def raw(self, topic: str) -> tuple[NDArray[np.int64], NDArray[np.int64], list[bytes]]:
+        """``(log_ns, order, payloads)`` of ``topic`` in recording order: log times (ns) and
+        positions in the recording, shape (n,), and the n CDR payloads, undecoded."""
+        info = self._topics[topic]
+        if info.encoding != "cdr":
+            raise InputError(f"topic {topic!r} has message encoding {info.encoding!r}, not cdr")
+        return np.array(info.log_ns, dtype=np.int64), np.array(info.order, dtype=np.int64), info.data
 
     def resolve(self, name: str) -> str:
         """The recorded topic called ``name``, also matched without its namespace prefix.
@@ -168,7 +233,10 @@ class Bag:
             if topic.encoding != "cdr":
                 raise InputError(f"topic {name!r} has message encoding {topic.encoding!r}, not cdr")
             cls = message_class(topic.type_name)
-            streams.extend((t, order, name, cls, data) for t, order, data in topic.raw)
+            streams.extend(
+                (t, order, name, cls, data)
+                for t, order, data in zip(topic.log_ns, topic.order, topic.data, strict=True)
+            )
         streams.sort(key=lambda item: (item[0], item[1]))
         for log_time, order, name, cls, data in streams:
             try:

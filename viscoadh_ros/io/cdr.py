@@ -1,0 +1,149 @@
+"""Bulk CDR for the fixed-layout messages of a replay: decode and encode whole arrays at once.
+
+``rclpy.serialization`` converts one message object per call (several microseconds each), which
+alone exceeds the replay budget at 1 kHz. The messages replay reads and writes are a header
+(``stamp.sec`` int32, ``stamp.nanosec`` uint32, ``frame_id`` string) followed by fixed-size
+numbers, so a batch whose frame ids have one length shares one byte layout: a numpy structured
+view reads or writes every message's fields in one pass. The layout follows ROS 2's CDR
+(XCDR1, little endian): a 4-byte encapsulation header ``00 01 00 00``, then each field aligned
+to its own size counted from the end of that header; a string is a uint32 length (including
+the terminating NUL) and its bytes. Tests check every type byte for byte against rclpy.
+
+Field names are message paths (``wrench.force.z``); ``stamp_ns`` is the header stamp in ns.
+Anything this module cannot take in bulk (another type, big-endian data, frame ids of
+different lengths in one batch) makes :func:`decode` return None, so callers fall back to rclpy.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+_ENCAPSULATION = b"\x00\x01\x00\x00"  # CDR little endian, no options
+_HEADER = 4  # encapsulation header bytes; CDR alignment counts from its end
+
+_XYZ = ("x", "y", "z")
+#: Fields after the header (or the whole message when not stamped), in order: (path, dtype).
+_FIELDS: dict[str, tuple[bool, tuple[tuple[str, str], ...]]] = {
+    "viscoadh_msgs/msg/IndentationCommand": (True, (("mode", "u1"), ("depth", "<f8"), ("force", "<f8"))),
+    "std_msgs/msg/Float64": (False, (("data", "<f8"),)),
+    "geometry_msgs/msg/PointStamped": (True, tuple((f"point.{a}", "<f8") for a in _XYZ)),
+    "geometry_msgs/msg/PoseStamped": (
+        True,
+        tuple((f"pose.position.{a}", "<f8") for a in _XYZ)
+        + tuple((f"pose.orientation.{a}", "<f8") for a in (*_XYZ, "w")),
+    ),
+    "geometry_msgs/msg/WrenchStamped": (
+        True,
+        tuple((f"wrench.{v}.{a}", "<f8") for v in ("force", "torque") for a in _XYZ),
+    ),
+    "viscoadh_msgs/msg/ContactState": (
+        True,
+        (
+            ("depth", "<f8"),
+            ("force", "<f8"),
+            ("contact_radius", "<f8"),
+            ("phase", "u1"),
+            ("edge_speed", "<f8"),
+            ("effective_work_of_adhesion", "<f8"),
+            ("energy_input", "<f8"),
+            ("energy_dissipated", "<f8"),
+            ("scale_separation_ok", "?"),
+            ("unstable", "?"),
+            ("model", "u1"),
+            ("commands_received", "<u4"),
+            ("commands_rejected", "<u4"),
+        ),
+    ),
+}
+
+#: Message types this module decodes and encodes.
+TYPES = frozenset(_FIELDS)
+
+
+def _layout(type_name: str, frame_bytes: int) -> np.dtype:
+    """Structured dtype of one serialised message whose ``frame_id`` has ``frame_bytes`` bytes
+    (without its NUL); fields at their CDR offsets, itemsize = the serialised size."""
+    stamped, fields = _FIELDS[type_name]
+    entries = [("encapsulation", "V4", 0)]  # (name, format, offset from the payload start)
+    position = 0  # from the end of the encapsulation header
+    if stamped:
+        entries += [
+            ("stamp.sec", "<i4", _HEADER),
+            ("stamp.nanosec", "<u4", _HEADER + 4),
+            ("frame_id.length", "<u4", _HEADER + 8),
+            ("frame_id", f"S{frame_bytes + 1}", _HEADER + 12),
+        ]
+        position = 12 + frame_bytes + 1
+    for name, fmt in fields:
+        size = np.dtype(fmt).itemsize
+        position += -position % size  # align to the field's own size
+        entries.append((name, fmt, _HEADER + position))
+        position += size
+    names, formats, offsets = zip(*entries, strict=True)
+    return np.dtype(
+        {
+            "names": list(names),
+            "formats": list(formats),
+            "offsets": list(offsets),
+            "itemsize": _HEADER + position,
+        }
+    )
+
+
+def decode(type_name: str, payloads: Sequence[bytes]) -> dict[str, NDArray] | None:
+    """Every field of ``payloads`` (n CDR messages of ``type_name``) as arrays of shape (n,),
+    plus ``stamp_ns`` (int64, ns) for stamped types; None when they cannot be read in bulk."""
+    if type_name not in _FIELDS or not payloads:
+        return None
+    length = len(payloads[0])
+    if any(len(p) != length for p in payloads):
+        return None  # frame ids of different lengths
+    stamped = _FIELDS[type_name][0]
+    if length < (_HEADER + 12 if stamped else _HEADER):
+        return None
+    buffer = b"".join(payloads)
+    head = np.frombuffer(buffer, np.uint8).reshape(len(payloads), length)
+    if np.any(head[:, :_HEADER] != np.frombuffer(_ENCAPSULATION, np.uint8)):
+        return None  # big endian or XCDR2: rclpy reads those
+    frame = int(head[0, _HEADER + 8 : _HEADER + 12].view("<u4")[0]) - 1 if stamped else 0
+    if frame < 0:
+        return None
+    layout = _layout(type_name, frame)
+    if layout.itemsize != length:
+        return None
+    records = np.frombuffer(buffer, layout)
+    if stamped and np.any(records["frame_id.length"] != frame + 1):
+        return None
+    columns = {name: records[name].copy() for name, _ in _FIELDS[type_name][1]}
+    if stamped:
+        columns["stamp_ns"] = records["stamp.sec"].astype(np.int64) * 1_000_000_000 + records["stamp.nanosec"]
+    return columns
+
+
+def encode(
+    type_name: str, stamp_ns: ArrayLike, frame_id: str, fields: Mapping[str, ArrayLike]
+) -> list[bytes]:
+    """CDR payloads of ``type_name``, one per stamp (ns >= 0, shape (n,)), with the given
+    field values (arrays of shape (n,) or scalars; fields not given are zero)."""
+    stamps = np.asarray(stamp_ns, dtype=np.int64)
+    frame = frame_id.encode()
+    layout = _layout(type_name, len(frame))
+    records = np.zeros(stamps.shape[0], layout)
+    records["encapsulation"] = np.void(_ENCAPSULATION)
+    if _FIELDS[type_name][0]:
+        if np.any(stamps < 0):
+            raise ValueError(f"{type_name}: stamps must be >= 0 ns")
+        records["stamp.sec"], records["stamp.nanosec"] = np.divmod(stamps, 1_000_000_000)
+        records["frame_id.length"] = len(frame) + 1
+        records["frame_id"] = frame
+    known = {name for name, _ in _FIELDS[type_name][1]}
+    for name, values in fields.items():
+        if name not in known:
+            raise KeyError(f"{type_name} has no field {name!r}")
+        records[name] = values
+    size = layout.itemsize
+    data = records.tobytes()
+    return [data[k : k + size] for k in range(0, len(data), size)]
