@@ -82,6 +82,14 @@ def node_run(tmp_path_factory: pytest.TempPathFactory) -> Iterator[NodeRun]:
                     clock.publish(Clock(clock=ns_to_stamp(round((START_S + tick) * 1e9))))
                     time.sleep(0.05)  # wall time for the node's timer to fire on the new clock
             answers.append(driver.command(START_S + t, d))
+        # /diagnostics runs on the executor thread, the answers on the node's live thread: wait
+        # for the diagnostics of the last clock period before the node is stopped.
+        last_period_ns = int(START_S + TIMES[-1]) * 10**9
+        deadline = time.monotonic() + 10.0
+        while time.monotonic() < deadline and not any(
+            stamp_to_ns(array.header.stamp) >= last_period_ns for array in diagnostics
+        ):
+            time.sleep(0.01)
     yield NodeRun(log, answers, diagnostics)
 
 
