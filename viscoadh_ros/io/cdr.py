@@ -59,6 +59,8 @@ _FIELDS: dict[str, tuple[bool, tuple[tuple[str, str], ...]]] = {
     ),
 }
 
+CONTACT_STATE = "viscoadh_msgs/msg/ContactState"
+WRENCH = "geometry_msgs/msg/WrenchStamped"
 #: Message types this module decodes and encodes.
 TYPES = frozenset(_FIELDS)
 

@@ -21,13 +21,15 @@ import datetime
 import queue
 import threading
 from collections import Counter
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import IO, Any
 
+import numpy as np
 import yaml
 from mcap.writer import CompressionType, Writer
+from numpy.typing import NDArray
 from rclpy.serialization import serialize_message
 
 from viscoadh_ros import __version__
@@ -88,6 +90,57 @@ def plain(value: Any) -> Any:
     return value
 
 
+def _metadata(scene: Mapping[str, Any] | None) -> dict[str, str]:
+    """The :data:`METADATA_NAME` record: the scene as YAML and the software version."""
+    return {
+        SCENE_KEY: yaml.safe_dump(plain(scene), sort_keys=False) if scene is not None else "",
+        VERSION_KEY: __version__,
+    }
+
+
+@dataclass(frozen=True)
+class TopicData:
+    """Every message of one topic for :func:`write_mcap`: ``log_ns`` (n,) int ns, ``payloads``
+    the n CDR messages of ``type_name``."""
+
+    topic: str
+    type_name: str
+    log_ns: NDArray[np.int64]
+    payloads: Sequence[bytes]
+
+
+def write_mcap(
+    path: str | Path,
+    topics: Sequence[TopicData],
+    *,
+    scene: Mapping[str, Any] | None = None,
+    chunk_size: int = 1024 * 1024,
+) -> None:
+    """Write a finished MCAP file (same format as :class:`McapRecorder`) of whole topics at once,
+    on the calling thread: for offline output, where nothing may be dropped and no live path
+    waits. Messages go in log-time order; at equal times the k-th messages of the topics
+    before the (k+1)-th, topics in the given order (so a state and its wrench stay together).
+    """
+    for data in topics:
+        if len(data.log_ns) != len(data.payloads):
+            raise ValueError(f"{data.topic}: {len(data.log_ns)} log times for {len(data.payloads)} messages")
+    which = np.concatenate([np.full(len(d.payloads), t, dtype=np.int64) for t, d in enumerate(topics)])
+    index = np.concatenate([np.arange(len(d.payloads), dtype=np.int64) for d in topics])
+    log_ns = np.concatenate([np.asarray(d.log_ns, dtype=np.int64) for d in topics])
+    order = np.lexsort((which, index, log_ns))
+    file = _File(Path(path), chunk_size=chunk_size, metadata=_metadata(scene))
+    try:
+        channels = [file.channel(d.topic, d.type_name, TopicQos()) for d in topics]
+        payloads = [d.payloads for d in topics]
+        add = file.writer.add_message
+        for t, k, ns in zip(
+            which[order].tolist(), index[order].tolist(), log_ns[order].tolist(), strict=True
+        ):
+            add(channels[t], log_time=ns, publish_time=ns, data=payloads[t][k], sequence=k)
+    finally:
+        file.finish()
+
+
 class _File:
     """One open MCAP file with its channels; the writer thread is its only user."""
 
@@ -106,20 +159,23 @@ class _File:
         self.last_ns = 0
         self.position = self.stream.tell()
 
-    def write(self, item: _Item, qos: TopicQos) -> None:
-        channel = self.channels.get(item.topic)
+    def channel(self, topic: str, type_name: str, qos: TopicQos) -> int:
+        """The channel id of ``topic``, registered (with its schema) on first use."""
+        channel = self.channels.get(topic)
         if channel is None:
-            schema = self.schemas.get(item.type_name)
+            schema = self.schemas.get(type_name)
             if schema is None:
-                schema = self.writer.register_schema(
-                    item.type_name, "ros2msg", schema_text(item.type_name).encode()
-                )
-                self.schemas[item.type_name] = schema
+                schema = self.writer.register_schema(type_name, "ros2msg", schema_text(type_name).encode())
+                self.schemas[type_name] = schema
             channel = self.writer.register_channel(
-                item.topic, "cdr", schema, {"offered_qos_profiles": qos.to_yaml()}
+                topic, "cdr", schema, {"offered_qos_profiles": qos.to_yaml()}
             )
-            self.channels[item.topic] = channel
-            self.topic_types[item.topic] = item.type_name
+            self.channels[topic] = channel
+            self.topic_types[topic] = type_name
+        return channel
+
+    def write(self, item: _Item, qos: TopicQos) -> None:
+        channel = self.channel(item.topic, item.type_name, qos)
         self.writer.add_message(
             channel,
             log_time=item.stamp_ns,
@@ -191,10 +247,7 @@ class McapRecorder:
         self._max_bytes = max_bytes
         self._max_duration_ns = int(max_duration * 1e9)
         self._qos = dict(qos or {})
-        self._metadata = {
-            SCENE_KEY: yaml.safe_dump(plain(scene), sort_keys=False) if scene is not None else "",
-            VERSION_KEY: __version__,
-        }
+        self._metadata = _metadata(scene)
         self._queue: queue.Queue[Any] = queue.Queue(maxsize=queue_size)
         self._dropped = 0
         self._written = 0
