@@ -578,22 +578,54 @@ def _energy_density(x, d, interior, n_in, wl, wsum, dx, g_c, gf, df, e0, e_kelvi
 
 
 @numba.njit(cache=True)
+def _node_density(x, d, interior, i0, i1, t, wl, g_c, gf, df, e0, e_kelvin, steady):
+    """`_energy_density` at x between element centres i0 <= i1 of one side (t: the weight
+    of i1), where the memory deviation is the plain linear interpolation: the same values
+    without `_w_side`'s branches (the stored energy is evaluated every step)."""
+    g = _g_at(x, gf, df)
+    total = 0.0
+    lsum = 0.0
+    for k in range(wl.shape[1]):
+        if interior:
+            coef = steady[k]
+            v0 = wl[i0, k] - coef * (d - g_c[i0])
+            v1 = wl[i1, k] - coef * (d - g_c[i1])
+            lk = coef * (d - g) + v0 + t * (v1 - v0)
+        else:
+            lk = wl[i0, k] + t * (wl[i1, k] - wl[i0, k])
+        lsum += lk
+        total += e_kelvin[k] * lk * lk
+    if interior:
+        l0 = d - g - lsum
+        total += e0 * l0 * l0
+    return total
+
+
+@numba.njit(cache=True)
 def _side_energy(x0, x1, d, interior, n_in, wl, wsum, dx, g_c, gf, df, e0, e_kelvin, steady):
     """Integral of `_energy_density` over (x0, x1) on one side of the edge, J: Simpson on
     each piece between element centres, where the interpolated memory is linear (exact for
-    a paraboloid's quartic density, so a few points per element suffice)."""
+    a paraboloid's quartic density, so a few points per element suffice). Pieces between
+    two centres of the side take `_node_density`; the end pieces (held or extrapolated
+    memory, cut by the edge) the general density."""
+    n = wl.shape[0]
+    lo, hi = (0, n_in - 1) if interior else (n_in, n - 1)
     total = 0.0
     prev = x0
     e_prev = _energy_density(prev, d, interior, n_in, wl, wsum, dx, g_c, gf, df, e0, e_kelvin, steady)
-    for i in range(wl.shape[0] + 1):
-        xi = (i + 0.5) * dx if i < wl.shape[0] else x1
+    for i in range(n + 1):
+        xi = (i + 0.5) * dx if i < n else x1
         if xi <= x0:
             continue
         if xi > x1:
             xi = x1
         mid = 0.5 * (prev + xi)
-        e_mid = _energy_density(mid, d, interior, n_in, wl, wsum, dx, g_c, gf, df, e0, e_kelvin, steady)
-        e_i = _energy_density(xi, d, interior, n_in, wl, wsum, dx, g_c, gf, df, e0, e_kelvin, steady)
+        if i - 1 >= lo and i <= hi and xi == (i + 0.5) * dx and prev == (i - 0.5) * dx:
+            e_mid = _node_density(mid, d, interior, i - 1, i, 0.5, wl, g_c, gf, df, e0, e_kelvin, steady)
+            e_i = _node_density(xi, d, interior, i, i, 0.0, wl, g_c, gf, df, e0, e_kelvin, steady)
+        else:
+            e_mid = _energy_density(mid, d, interior, n_in, wl, wsum, dx, g_c, gf, df, e0, e_kelvin, steady)
+            e_i = _energy_density(xi, d, interior, n_in, wl, wsum, dx, g_c, gf, df, e0, e_kelvin, steady)
         total += (xi - prev) * (e_prev + 4.0 * e_mid + e_i) / 6.0
         prev, e_prev = xi, e_i
         if xi >= x1:
