@@ -5,6 +5,7 @@ force control, pull-off prediction and bad input."""
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -13,6 +14,7 @@ from viscoadh_ros.core import reference
 from viscoadh_ros.core.config import SceneConfig
 from viscoadh_ros.core.criterion import (
     critical_edge_speeds,
+    scale_separation_holds,
     work_of_adhesion_detaching,
     work_of_adhesion_indenting,
 )
@@ -274,3 +276,16 @@ def test_scale_separation_flag_follows_the_edge_speed() -> None:
     held = ContactSimulator(contact)
     held.step(1.0, depth=1e-6)
     assert held.step(2.0, depth=1e-6).scale_separation_ok, "pinned edge"
+
+
+def test_scalar_scale_separation_agrees_with_the_criterion_module() -> None:
+    """The simulator's per-step scalar check is `scale_separation_holds` at factor 1,
+    including speeds exactly at both thresholds."""
+    scene = Path(__file__).resolve().parents[1] / "config" / "default.yaml"
+    physics = ContactSimulator(SceneConfig.from_yaml(scene).contacts[0]).physics
+    v_c1, v_c2 = physics.critical_speeds
+    speeds = [0.0, v_c1, -v_c2, 0.5 * v_c1, -0.5 * v_c2, 2.0 * v_c1, -2.0 * v_c2, 1e-300, -1e-300, 1.0, -1.0]
+    for speed in speeds:
+        assert physics.scale_separation_ok(speed) == bool(
+            scale_separation_holds(speed, physics.critical_speeds)
+        ), f"edge_speed={speed!r} (v_c1={v_c1!r}, v_c2={v_c2!r})"
