@@ -1,6 +1,7 @@
 """Numba kernels of the time-stepped MDR model (private).
 
-All kernels work in place on preallocated float64 arrays owned by the simulator. The
+All kernels work in place on preallocated float64 arrays owned by the simulator and release
+the GIL (`nogil=True`: a long history in a service thread does not block the node). The
 public wrappers at the bottom validate shapes, dtypes and finiteness *before* entering
 numba (a NaN that slips into a compiled loop would spread silently), and `warm_up()`
 compiles and calls every kernel once so the first real step does not stall.
@@ -51,11 +52,14 @@ _MAX_ATTEMPTS = 2000
 # all digits to cancellation there (1 - exp(-x) for x ~ 1e-12).
 _SERIES_LIMIT = 1e-4
 
+#: Edge roots are bisected to this fraction of an element width.
+EDGE_TOLERANCE = 1e-12
+
 #: Fine points per block of the first-touch search (`_first_touch`, `Row.gmin`).
 TOUCH_BLOCK = 32
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _phi(x: float) -> tuple:
     """Return ``(exp(-x), (1-exp(-x))/x, (x-1+exp(-x))/x^2)`` for x >= 0, safe at both ends."""
     if x < _SERIES_LIMIT:
@@ -69,7 +73,7 @@ def _phi(x: float) -> tuple:
     return e, one_minus / x, (x - one_minus) / (x * x)
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _interior_count(a: float, dx: float, n: int) -> int:
     """Number of elements in contact for radius ``a``: centres below ``a``, >= 1 if a > 0."""
     if a <= 0.0:
@@ -82,7 +86,7 @@ def _interior_count(a: float, dx: float, n: int) -> int:
     return count
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _g_at(x: float, gf: np.ndarray, df: float) -> float:
     """Profile g at ``x`` by linear interpolation on the fine grid."""
     m = gf.shape[0]
@@ -95,7 +99,7 @@ def _g_at(x: float, gf: np.ndarray, df: float) -> float:
     return gf[j] + t * (gf[j + 1] - gf[j])
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _w_side(x, values, lo, hi, dx, coef, d, g_c, gf, df):
     """Memory at x from elements lo..hi (one side of the edge), m.
 
@@ -141,18 +145,20 @@ def _w_side(x, values, lo, hi, dx, coef, d, g_c, gf, df):
     return base + v_i + t * (v_j - v_i)
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _h(x, d, wsum, lo, hi, dx, g_c, gf, df, c_crit, kap):
     """Criterion gap h(x) with the memory of elements lo..hi; interior sides pass kap."""
     return d - _g_at(x, gf, df) - _w_side(x, wsum, lo, hi, dx, kap, d, g_c, gf, df) + c_crit * math.sqrt(x)
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _bisect(x_lo, x_hi, d, wsum, lo, hi, dx, g_c, gf, df, c_crit, kap):
-    """Root of h between x_lo (h >= 0) and x_hi (h < 0), to machine precision."""
+    """Root of h between x_lo (h >= 0) and x_hi (h < 0), to ``EDGE_TOLERANCE * dx``: far
+    below the discretisation error, and half the iterations of machine precision."""
+    tol = EDGE_TOLERANCE * dx
     for _ in range(80):
         mid = 0.5 * (x_lo + x_hi)
-        if mid <= x_lo or mid >= x_hi:
+        if mid <= x_lo or mid >= x_hi or x_hi - x_lo <= tol:
             break
         if _h(mid, d, wsum, lo, hi, dx, g_c, gf, df, c_crit, kap) >= 0.0:
             x_lo = mid
@@ -161,7 +167,7 @@ def _bisect(x_lo, x_hi, d, wsum, lo, hi, dx, g_c, gf, df, c_crit, kap):
     return 0.5 * (x_lo + x_hi)
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _scan_out(x_start, d, wsum, lo, hi, dx, g_c, gf, df, c_crit, reach):
     """Outermost point of the h >= 0 run that starts at x_start (exterior memory): scan
     the fine grid outward.
@@ -187,7 +193,7 @@ def _scan_out(x_start, d, wsum, lo, hi, dx, g_c, gf, df, c_crit, reach):
     return prev, True
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _first_touch(d, wsum, dx, g_c, gf, gmin, df, reach):
     """First fine point (index) where the surface with its memory reaches the indenter,
     ``d - g - w >= 0``, or -1 if none up to `reach`.
@@ -223,7 +229,7 @@ def _first_touch(d, wsum, dx, g_c, gf, gmin, df, reach):
     return -1
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _locate_edge(a, d, wsum, dx, g_c, gf, gmin, df, c_crit, reach, kap):
     """Apply the energy criterion both ways at depth d. Returns (new radius, motion, grow)."""
     n = wsum.shape[0]
@@ -263,7 +269,7 @@ def _locate_edge(a, d, wsum, dx, g_c, gf, gmin, df, c_crit, reach, kap):
     return a, MOTION_NONE, False
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _deviation_integral(a, d, wsum, n_in, dx, g_c, gf, df, kap):
     """Integral over (0, a) of the interpolated interior deviation v = w - kap u, m^2."""
     if n_in == 0:
@@ -291,7 +297,7 @@ def _deviation_integral(a, d, wsum, n_in, dx, g_c, gf, df, kap):
     return total
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _profile_integral(a, gf, gint, df):
     """Integral of g over (0, a), m^2, consistent with the linear fine-grid profile."""
     m = gf.shape[0]
@@ -302,7 +308,7 @@ def _profile_integral(a, gf, gint, df):
     return gint[j] + 0.5 * (a - xj) * (gf[j] + _g_at(a, gf, df))
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _force(a, d, wsum, dx, g_c, gf, gint, df, e0, kap):
     """Normal force ``F = 2 E0* int_0^a (u - w) dx = 2 E0* ((1-kap) int u - int v)``, N."""
     if a <= 0.0:
@@ -312,7 +318,7 @@ def _force(a, d, wsum, dx, g_c, gf, gint, df, e0, kap):
     return 2.0 * e0 * ((1.0 - kap) * u_int - _deviation_integral(a, d, wsum, n_in, dx, g_c, gf, df, kap))
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _contact_coefficients(lam, dt, e, phi1, chi):
     """Per-mode coefficients of the exact linear-input update over dt (into e, phi1, chi)."""
     for m in range(lam.shape[0]):
@@ -322,7 +328,7 @@ def _contact_coefficients(lam, dt, e, phi1, chi):
         chi[m] = f2 * dt
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _chain_in_contact(wl, wsum, i, u0, u1, p, p_inv, beta, e, phi1, chi, z):
     """Element i in contact, total elongation u linear from u0 to u1 (coefficients given)."""
     k_count = wl.shape[1]
@@ -341,7 +347,7 @@ def _chain_in_contact(wl, wsum, i, u0, u1, p, p_inv, beta, e, phi1, chi, z):
     wsum[i] = total
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _chain_free(wl, wsum, i, decay):
     """Element i out of contact: each Kelvin element creeps back by its factor `decay`."""
     total = 0.0
@@ -351,7 +357,7 @@ def _chain_free(wl, wsum, i, decay):
     wsum[i] = total
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _kelvin_update(wl, wsum, n_in, d0, d1, dt, g_c, p, p_inv, lam, beta, rate):
     """Exact update of every Kelvin chain over dt for a depth linear from d0 to d1.
 
@@ -374,7 +380,7 @@ def _kelvin_update(wl, wsum, n_in, d0, d1, dt, g_c, p, p_inv, lam, beta, rate):
         _chain_free(wl, wsum, i, e)
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _retime_crossed(wl, wsum, scratch, a0, a1, da, db, dt, dx, g_c, p, p_inv, lam, beta, rate):
     """Redo the substep for the elements the edge crossed, switching them at the crossing.
 
@@ -428,7 +434,7 @@ def _retime_crossed(wl, wsum, scratch, a0, a1, da, db, dt, dx, g_c, p, p_inv, la
             _chain_free(wl, wsum, i, decay)
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _advance(
     wl,
     wsum,
@@ -530,7 +536,7 @@ def _advance(
     return STATUS_OK
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _remap(wl, a, d, dx, g_c, gf, df, steady, new_dx, out):
     """Kelvin state of a regridded row (element width new_dx) into ``out`` (N', K).
 
@@ -554,7 +560,7 @@ def _remap(wl, a, d, dx, g_c, gf, df, steady, new_dx, out):
                 out[i, k] = _w_side(x, wl[:, k], lo, hi, dx, coef, d, g_c, gf, df)
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _energy_density(x, d, interior, n_in, wl, wsum, dx, g_c, gf, df, e0, e_kelvin, steady):
     """Spring energy per unit length at x, J/m: E0* l0^2 + sum_k E_k* l_k^2 (both half-rows).
 
@@ -577,7 +583,7 @@ def _energy_density(x, d, interior, n_in, wl, wsum, dx, g_c, gf, df, e0, e_kelvi
     return total
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _node_density(x, d, interior, i0, i1, t, wl, g_c, gf, df, e0, e_kelvin, steady):
     """`_energy_density` at x between element centres i0 <= i1 of one side (t: the weight
     of i1), where the memory deviation is the plain linear interpolation: the same values
@@ -601,7 +607,7 @@ def _node_density(x, d, interior, i0, i1, t, wl, g_c, gf, df, e0, e_kelvin, stea
     return total
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _side_energy(x0, x1, d, interior, n_in, wl, wsum, dx, g_c, gf, df, e0, e_kelvin, steady):
     """Integral of `_energy_density` over (x0, x1) on one side of the edge, J: Simpson on
     each piece between element centres, where the interpolated memory is linear (exact for
@@ -633,7 +639,7 @@ def _side_energy(x0, x1, d, interior, n_in, wl, wsum, dx, g_c, gf, df, e0, e_kel
     return total
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _stored_energy(a, d, wl, wsum, dx, g_c, gf, df, e0, e_kelvin, steady):
     """Elastic energy in all springs of both half-rows, J: the integral of
     `_energy_density` over the contact (interior memory) and over (a, L) (exterior)."""
