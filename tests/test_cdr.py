@@ -76,3 +76,31 @@ def test_bulk_decode_declines_what_it_cannot_read() -> None:
     assert cdr.decode(wrench, [short[0][:-8]]) is None, "truncated payload"
     with pytest.raises(KeyError, match="no field 'wrench.force.w'"):
         cdr.encode(wrench, [0], "a", {"wrench.force.w": 1.0})
+
+
+def test_experiment_reads_mixed_frames_through_rclpy(tmp_path: Any) -> None:
+    """Frame ids of different lengths in one topic cannot be read in bulk: the rclpy fallback
+    gives the same experiment (log time for a zero stamp)."""
+    from geometry_msgs.msg import PointStamped, WrenchStamped
+
+    from viscoadh_ros.experiment import load_experiment
+    from viscoadh_ros.io.bag import Bag
+    from viscoadh_ros.io.mcap_log import McapRecorder
+
+    path = tmp_path / "mixed.mcap"
+    with McapRecorder(path) as recorder:
+        for k in range(4):
+            point, wrench = PointStamped(), WrenchStamped()
+            point.header.stamp.sec = wrench.header.stamp.sec = 10 + k
+            point.header.frame_id, wrench.header.frame_id = "a" * (k + 1), "b" * (3 - k)
+            point.point.z, wrench.wrench.force.z = 1e-6 * k, -0.5 * k
+            if k == 3:
+                wrench.header.stamp.sec = 0  # "on receipt": the log time
+            recorder.record("/p", point, (10 + k) * 1_000_000_000)
+            recorder.record("/w", wrench, (10 + k) * 1_000_000_000 + 5)
+    experiment = load_experiment(Bag(path))
+    np.testing.assert_array_equal(experiment.input_value, 1e-6 * np.arange(4), err_msg="depths")
+    np.testing.assert_array_equal(experiment.measured_force, -0.5 * np.arange(4), err_msg="forces")
+    np.testing.assert_array_equal(
+        experiment.measured_ns, [10e9, 11e9, 12e9, 13e9 + 5], err_msg="header stamps, else log time"
+    )
