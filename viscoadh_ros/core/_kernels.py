@@ -41,7 +41,9 @@ OUT_FORCE = 1
 OUT_WORK = 2
 OUT_MOTION = 3
 OUT_SUBSTEPS = 4
-OUT_SIZE = 5
+OUT_STORED = 5
+OUT_MEMORY = 6
+OUT_SIZE = 7
 
 # Substep attempts per `advance` after which the edge-motion limit is dropped for the rest of
 # the step: a guard (never reached in the test suite) so that an edge criterion flipping back
@@ -454,6 +456,8 @@ def _advance(
     beta,
     rate,
     kap,
+    e_kelvin,
+    steady,
     out,
     a,
     d0,
@@ -470,7 +474,9 @@ def _advance(
     Substeps are halved while the edge would move more than ``max_edge_move`` (m) in one
     of them, down to ``1e-7 dt``: a true jump (snap-in, the fold at pull-off) is thereby
     located in time and crossed in one tiny substep that does no work. Writes radius,
-    force, work input, last motion and substep count to ``out``. Returns STATUS_GROW
+    force, work input, last motion, substep count, the stored energy at the end
+    (`_stored_energy`) and the largest |wsum| to ``out``: in the same compiled call, where
+    separate calls cost their dispatch. Returns STATUS_GROW
     (state partly advanced: the caller restores) when the contact needs a larger domain.
     """
     n = wl.shape[0]
@@ -492,6 +498,8 @@ def _advance(
         out[OUT_WORK] = 0.5 * (force_prev + force_new) * (d1 - d0)
         out[OUT_MOTION] = motion
         out[OUT_SUBSTEPS] = 0
+        out[OUT_STORED] = _stored_energy(new_a, d1, wl, wsum, dx, g_c, gf, df, e0, e_kelvin, steady)
+        out[OUT_MEMORY] = _memory_peak(wsum)
         return STATUS_OK
     while tau < dt:
         h = step
@@ -533,6 +541,8 @@ def _advance(
     out[OUT_WORK] = work
     out[OUT_MOTION] = motion
     out[OUT_SUBSTEPS] = substeps
+    out[OUT_STORED] = _stored_energy(a, d1, wl, wsum, dx, g_c, gf, df, e0, e_kelvin, steady)
+    out[OUT_MEMORY] = _memory_peak(wsum)
     return STATUS_OK
 
 
@@ -584,11 +594,11 @@ def _energy_density(x, d, interior, n_in, wl, wsum, dx, g_c, gf, df, e0, e_kelvi
 
 
 @numba.njit(cache=True, nogil=True)
-def _node_density(x, d, interior, i0, i1, t, wl, g_c, gf, df, e0, e_kelvin, steady):
-    """`_energy_density` at x between element centres i0 <= i1 of one side (t: the weight
-    of i1), where the memory deviation is the plain linear interpolation: the same values
-    without `_w_side`'s branches (the stored energy is evaluated every step)."""
-    g = _g_at(x, gf, df)
+def _node_density(g, d, interior, i0, i1, t, wl, g_c, e0, e_kelvin, steady):
+    """`_energy_density` at a point of profile height g between element centres i0 <= i1
+    of one side (t: the weight of i1), where the memory deviation is the plain linear
+    interpolation: the same values without `_w_side`'s branches (the stored energy is
+    evaluated every step)."""
     total = 0.0
     lsum = 0.0
     for k in range(wl.shape[1]):
@@ -616,6 +626,11 @@ def _side_energy(x0, x1, d, interior, n_in, wl, wsum, dx, g_c, gf, df, e0, e_kel
     memory, cut by the edge) the general density."""
     n = wl.shape[0]
     lo, hi = (0, n_in - 1) if interior else (n_in, n - 1)
+    # When every centre and every midpoint between centres is a fine point (an even number
+    # of fine intervals per element, as the simulator builds rows), the profile there is
+    # read off the fine grid: `_g_at`'s two divisions per point were most of this loop.
+    per_cell = (gf.shape[0] - 1) // n
+    on_grid = per_cell * n == gf.shape[0] - 1 and per_cell % 2 == 0
     total = 0.0
     prev = x0
     e_prev = _energy_density(prev, d, interior, n_in, wl, wsum, dx, g_c, gf, df, e0, e_kelvin, steady)
@@ -627,8 +642,14 @@ def _side_energy(x0, x1, d, interior, n_in, wl, wsum, dx, g_c, gf, df, e0, e_kel
             xi = x1
         mid = 0.5 * (prev + xi)
         if i - 1 >= lo and i <= hi and xi == (i + 0.5) * dx and prev == (i - 0.5) * dx:
-            e_mid = _node_density(mid, d, interior, i - 1, i, 0.5, wl, g_c, gf, df, e0, e_kelvin, steady)
-            e_i = _node_density(xi, d, interior, i, i, 0.0, wl, g_c, gf, df, e0, e_kelvin, steady)
+            if on_grid:
+                g_mid = gf[per_cell * i]
+                g_i = gf[per_cell * i + per_cell // 2]
+            else:
+                g_mid = _g_at(mid, gf, df)
+                g_i = _g_at(xi, gf, df)
+            e_mid = _node_density(g_mid, d, interior, i - 1, i, 0.5, wl, g_c, e0, e_kelvin, steady)
+            e_i = _node_density(g_i, d, interior, i, i, 0.0, wl, g_c, e0, e_kelvin, steady)
         else:
             e_mid = _energy_density(mid, d, interior, n_in, wl, wsum, dx, g_c, gf, df, e0, e_kelvin, steady)
             e_i = _energy_density(xi, d, interior, n_in, wl, wsum, dx, g_c, gf, df, e0, e_kelvin, steady)
@@ -637,6 +658,15 @@ def _side_energy(x0, x1, d, interior, n_in, wl, wsum, dx, g_c, gf, df, e0, e_kel
         if xi >= x1:
             break
     return total
+
+
+@numba.njit(cache=True, nogil=True)
+def _memory_peak(wsum):
+    """Largest |wsum|, m: whether any memory is left (the simulator's idle test)."""
+    peak = 0.0
+    for i in range(wsum.shape[0]):
+        peak = max(peak, abs(wsum[i]))
+    return peak
 
 
 @numba.njit(cache=True, nogil=True)
@@ -765,6 +795,8 @@ class Row:
             self.beta,
             self.rate,
             self.kap,
+            self.e_kelvin,
+            self.steady,
             self.out,
         )
 
@@ -803,7 +835,8 @@ def advance(
     contact radius starting at `radius` (m).
 
     Returns ``(status, out)``; ``out[OUT_RADIUS]`` is the new contact radius (m),
-    ``out[OUT_FORCE]`` the force (N), ``out[OUT_WORK]`` the work input (J). On STATUS_GROW
+    ``out[OUT_FORCE]`` the force (N), ``out[OUT_WORK]`` the work input (J),
+    ``out[OUT_STORED]`` the stored energy at the end (J, `stored_energy`). On STATUS_GROW
     the row is partly advanced and must be restored by the caller.
     """
     _check_scalars(radius=radius, d0=d0, d1=d1, dt=dt, max_edge_move=max_edge_move)

@@ -308,6 +308,11 @@ class _TimeStepped:
         self.row: _kernels.Row | None = None
         self.radius = 0.0
         self.substeps = 0
+        # (depth m, stored energy J) of the state the last `advance` left, None once the
+        # state changed otherwise.
+        self._stored: tuple[float, float] | None = None
+        # Largest |wsum| (m) the last `advance` left, None once the state changed otherwise.
+        self._memory_peak: float | None = None
 
     # -- the domain ---------------------------------------------------------------------
     def _build_row(self, length: float, memory: np.ndarray | None) -> _kernels.Row:
@@ -376,27 +381,35 @@ class _TimeStepped:
         start = self.get_state()
         while True:
             row = self.row
-            status, out = _kernels.advance(
-                row,
+            # The kernel itself, not the validating wrapper: the row's arrays are checked
+            # when built, the step's scalars by ContactSimulator.step.
+            status = _kernels._advance(
+                *row.kernel_args,
                 self.radius,
                 d0,
                 d1,
                 dt,
-                max_substep=self.numerics.max_substep,
-                max_edge_move=self.numerics.max_edge_cells * row.dx,
+                self.numerics.max_substep,
+                self.numerics.max_edge_cells * row.dx,
             )
             if status == _kernels.STATUS_OK:
                 break
             self.set_state(start)
             self._grow(d0)
             start = self.get_state()
+        out = row.out
         self.radius = float(out[_kernels.OUT_RADIUS])
         self.substeps = int(out[_kernels.OUT_SUBSTEPS])
+        self._stored = (d1, float(out[_kernels.OUT_STORED]))
+        self._memory_peak = float(out[_kernels.OUT_MEMORY])
         return self.radius, float(out[_kernels.OUT_FORCE]), float(out[_kernels.OUT_WORK])
 
     def stored_energy(self, depth: float) -> float:
         if self.row is None:
             return 0.0
+        # The kernel computed it at the end of the last advance (same state, same depth).
+        if self._stored is not None and self._stored[0] == depth:
+            return self._stored[1]
         return _kernels.stored_energy(self.row, self.radius, depth)
 
     def edge_gaps(self, depth: float) -> tuple[float, float]:
@@ -412,14 +425,16 @@ class _TimeStepped:
             return True
         if self.radius > 0.0:
             return False
-        return (
-            float(np.max(np.abs(self.row.wsum), initial=0.0))
-            <= self.numerics.idle_tolerance * self.row.length
-        )
+        peak = self._memory_peak
+        if peak is None:
+            peak = float(np.max(np.abs(self.row.wsum), initial=0.0))
+        return peak <= self.numerics.idle_tolerance * self.row.length
 
     def drop_memory(self) -> None:
         """Forget a relaxed, out-of-contact state: the next contact sizes a fresh domain."""
         self.row = None
+        self._stored = None
+        self._memory_peak = None
 
     def get_state(self) -> tuple:
         if self.row is None:
@@ -429,6 +444,8 @@ class _TimeStepped:
     def set_state(self, state: tuple) -> None:
         radius, row, memory = state
         self.radius = radius
+        self._stored = None
+        self._memory_peak = None
         if row is None:
             self.row = None
         elif row is self.row:
@@ -441,6 +458,8 @@ class _TimeStepped:
     def reset(self) -> None:
         self.radius = 0.0
         self.row = None
+        self._stored = None
+        self._memory_peak = None
 
 
 def _modal_chain(e0: float, e_kelvin: np.ndarray, eta_kelvin: np.ndarray) -> tuple[np.ndarray, ...]:
