@@ -90,9 +90,11 @@ def test_tutorial_1_gripper_releases_as_predicted(tmp_path):
     assert match, f"no release line in:\n{output}"
     reached, predicted = float(match.group(1)), float(match.group(2))
     assert predicted < 0, f"the release must be predicted to pull:\n{output}"
-    # The finger keeps holding for a few ms between the answer and the start of the release,
-    # and samples the force at 200 Hz: a few per cent, not more.
-    np.testing.assert_allclose(reached, predicted, rtol=0.05, err_msg="gripper: reached vs predicted")
+    # The run is on a simulated clock in lockstep with the finger (no wall-clock timing in it):
+    # the finger releases in the period after the answers, at the predicted speed, and reads
+    # the force once per 1 ms period (a quarter of the critical depth at the fastest speed),
+    # so the sampled peak sits within a per cent of the predicted one.
+    np.testing.assert_allclose(reached, predicted, rtol=0.01, err_msg="gripper: reached vs predicted")
 
 
 def test_tutorial_2_fit_recovers_the_recorded_material(tmp_path):
