@@ -151,6 +151,64 @@ def test_quick_cli_writes_json_report_and_figure(
     assert rendered.read_text() == text.replace("## Kernel", "## Notes\n\nA cause.\n\n## Kernel", 1)
 
 
+def test_sections_run_merges_into_the_existing_json(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A --sections run replaces only its sections and says which command measured what."""
+    monkeypatch.setattr(suite, "QUICK", TINY)
+    json_path, output = tmp_path / "results.json", tmp_path / "BENCH.md"
+
+    def bench(sections: str) -> dict[str, Any]:
+        argv = ["bench", "--quick", "--sections", sections, "--json", str(json_path), "--output", str(output)]
+        assert cli_main(argv) == 0, capsys.readouterr().err
+        return json.loads(json_path.read_text())
+
+    first = bench("kernel")
+    second = bench("accuracy")
+    assert second["kernel"] == first["kernel"], "a run of accuracy must keep the kernel section"
+    assert {r["preset"] for r in second["presets"]} == {"fast", "balanced", "accurate"}
+    assert second["command"] == first["command"], "the header keeps the first run's command"
+    assert {name: run["command"] for name, run in second["runs"].items()} == {
+        "kernel": f"viscoadh bench --quick --json {json_path} --output {output} --sections kernel",
+        "accuracy": f"viscoadh bench --quick --json {json_path} --output {output} --sections accuracy",
+    }
+    text = output.read_text()
+    assert "## Kernel" in text and "## Accuracy" in text, "the report renders the merged results"
+    assert f"- accuracy: `{second['runs']['accuracy']['command']}` on" in text
+    assert "- kernel:" not in text, "the header's own run is not listed again"
+    third = bench("kernel")
+    assert len(third["kernel"]) == len(first["kernel"]), "a section is replaced, never appended"
+    assert third["accuracy"] == second["accuracy"] and third["runs"]["accuracy"] == second["runs"]["accuracy"]
+
+
+def test_merge_into_a_file_written_before_runs_existed() -> None:
+    run = {"command": "viscoadh bench", "date": "d0", "machine": "m", "quick": False}
+    old = {
+        **run,
+        "kernel": [1],
+        "accuracy": [2],
+        "presets": [3],
+        "node": {"startup_s": 1.0},
+        "startup_s": 1.0,
+    }
+    new_run = {**run, "command": "viscoadh bench --sections node", "date": "d1"}
+    new = {**new_run, "node": {"startup_s": 2.0}, "startup_s": 2.0, "runs": {"node": new_run}}
+    merged = suite.merge(old, new)
+    assert merged["startup_s"] == 2.0 and merged["kernel"] == [1] and merged["presets"] == [3]
+    assert merged["runs"] == {"kernel": run, "accuracy": run, "node": new_run}
+    assert merged["command"] == "viscoadh bench", "a partial run leaves the header to the full one"
+
+
+def test_unreadable_json_stops_the_run_with_nothing_changed(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    json_path = tmp_path / "results.json"
+    json_path.write_text('{"kernel": []}')
+    assert cli_main(["bench", "--quick", "--sections", "kernel", "--json", str(json_path)]) == 2
+    assert "--json: cannot merge into" in capsys.readouterr().err
+    assert json_path.read_text() == '{"kernel": []}'
+
+
 def test_unknown_section_exits_2_with_one_line(capsys: pytest.CaptureFixture[str]) -> None:
     assert cli_main(["bench", "--sections", "kernel,warp"]) == 2
     err = capsys.readouterr().err

@@ -126,6 +126,21 @@ def render_markdown(results: dict[str, Any], figure: Path | None, notes: str | N
         f"Date: {results['date']}. Machine: {results['machine']}.",
         "",
     ]
+    header_run = (results["command"], results["date"])
+    later = {
+        name: run
+        for name, run in results.get("runs", {}).items()
+        if (run["command"], run["date"]) != header_run
+    }
+    if later:
+        lines += ["Sections measured by another command (merged into the results JSON):", ""]
+        lines += [
+            f"- {name}: `{run['command']}` on {run['date']}"
+            + (" (quick sizes)" if run["quick"] else "")
+            + (f", machine: {run['machine']}" if run["machine"] != results["machine"] else "")
+            for name, run in later.items()
+        ]
+        lines.append("")
     if notes:
         lines += [notes.strip(), ""]
     if "kernel" in results:

@@ -10,6 +10,17 @@ from dataclasses import dataclass
 from typing import Any
 
 SECTIONS = ("kernel", "accuracy", "node", "replay")
+#: The results keys each section writes (the soak is asked for by --soak, not --sections); a
+#: merge replaces exactly these.
+SECTION_KEYS = {
+    "kernel": ("kernel",),
+    "accuracy": ("accuracy", "presets"),
+    "node": ("node", "startup_s"),
+    "replay": ("replay",),
+    "soak": ("soak",),
+}
+#: Top-level keys that describe the run the report header names.
+RUN_KEYS = ("command", "date", "machine", "quick")
 
 
 @dataclass(frozen=True)
@@ -82,7 +93,11 @@ def run(
     command: str,
     progress: Callable[[str], None],
 ) -> dict[str, Any]:
-    """Run the chosen sections (plus the soak when asked) and return the results dictionary."""
+    """Run the chosen sections (plus the soak when asked) and return the results dictionary.
+
+    Besides the sections' keys (SECTION_KEYS) it holds the run's RUN_KEYS and ``runs``: for
+    each section that ran, the same four, so a merge can tell which command measured what.
+    """
     unknown = sorted(set(sections) - set(SECTIONS))
     if unknown:
         raise ValueError(f"sections: unknown {', '.join(unknown)} (known: {', '.join(SECTIONS)})")
@@ -139,4 +154,38 @@ def run(
 
         progress(f"soak: {soak_minutes:g} min on 8 contacts with logging on")
         results["soak"] = soak(minutes=soak_minutes)
+    run_info = {key: results[key] for key in RUN_KEYS}
+    results["runs"] = {name: dict(run_info) for name in SECTION_KEYS if name in results}
     return results
+
+
+def is_results(data: Any) -> bool:
+    """Whether ``data`` (parsed JSON) looks like a results dictionary that can be merged into."""
+    return isinstance(data, dict) and all(key in data for key in RUN_KEYS)
+
+
+def merge(previous: dict[str, Any], new: dict[str, Any]) -> dict[str, Any]:
+    """``previous`` results with every section that ``new`` ran replaced by ``new``'s.
+
+    Sections ``new`` did not run keep their values and their ``runs`` entry (a file written
+    before ``runs`` existed counts as one run, its top-level RUN_KEYS; ``previous`` must have
+    them, see :func:`is_results`). The header's
+    RUN_KEYS become ``new``'s when it ran every section of SECTIONS, else stay ``previous``'s.
+    """
+    base = {key: previous[key] for key in RUN_KEYS if key in previous}
+    runs = {
+        name: dict(previous.get("runs", {}).get(name, base))
+        for name, keys in SECTION_KEYS.items()
+        if keys[0] in previous
+    }
+    merged = {key: value for key, value in previous.items() if key != "runs"}
+    for name in new["runs"]:
+        for key in SECTION_KEYS[name]:
+            merged.pop(key, None)
+            if key in new:
+                merged[key] = new[key]
+    runs.update(new["runs"])
+    if set(SECTIONS) <= set(new["runs"]):
+        merged.update({key: new[key] for key in RUN_KEYS})
+    merged["runs"] = {name: runs[name] for name in SECTION_KEYS if name in runs}
+    return merged

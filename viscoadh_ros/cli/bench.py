@@ -4,7 +4,9 @@
 
 A full run writes BENCHMARKS.md (tables, with the accuracy figure under the JSON's folder) and
 benchmarks/results.json; `--quick` (under about three minutes) writes only what is asked for
-with --json/--output and prints a summary. Each file records the command line that made it.
+with --json/--output and prints a summary. A run merges into an existing JSON: it replaces
+the sections it ran (with their command and date under "runs") and keeps the others, and the
+report is rendered from the merged results. Each file records the command lines that made it.
 A hand-written `notes.md` beside the JSON (causes of missed targets) is copied into the report.
 """
 
@@ -151,6 +153,19 @@ def main(args: argparse.Namespace) -> int:
     json_path = args.json if args.json is not None or args.quick else DEFAULT_JSON
     output = args.output if args.output is not None or args.quick else DEFAULT_OUTPUT
     command = _command_line(args, sections)
+    previous = None
+    if json_path is not None and json_path.exists():
+        # Read before measuring: an unreadable file stops the run with nothing changed.
+        try:
+            previous = json.loads(json_path.read_text(encoding="utf-8"))
+            if not suite.is_results(previous):
+                raise ValueError(f"not a results file (no {', '.join(suite.RUN_KEYS)})")
+        except (OSError, ValueError) as exc:
+            print(
+                f"viscoadh bench: error: --json: cannot merge into {str(json_path)!r}: {exc}",
+                file=sys.stderr,
+            )
+            return 2
     try:
         results = suite.run(
             suite.QUICK if args.quick else suite.FULL,
@@ -162,10 +177,11 @@ def main(args: argparse.Namespace) -> int:
     except RuntimeError as exc:
         print(f"viscoadh bench: error: {exc}", file=sys.stderr)
         return 1
+    merged = results if previous is None else suite.merge(previous, results)
     if json_path is not None:
         json_path.parent.mkdir(parents=True, exist_ok=True)
-        json_path.write_text(json.dumps(results, indent=2) + "\n", encoding="utf-8")
+        json_path.write_text(json.dumps(merged, indent=2) + "\n", encoding="utf-8")
     if output is not None:
-        _write_report(results, json_path or DEFAULT_JSON, output)
+        _write_report(merged, json_path or DEFAULT_JSON, output)
     print(_summary(results))
     return 0
