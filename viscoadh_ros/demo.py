@@ -425,14 +425,24 @@ def node_in_process(
         )
         executor = MultiThreadedExecutor(context=context)
         executor.add_node(node)
-        spinner = threading.Thread(target=executor.spin, name="viscoadh-executor", daemon=True)
+        stop = threading.Event()
+
+        def spin() -> None:
+            while not stop.is_set() and context.ok():
+                executor.spin_once(timeout_sec=0.05)
+
+        spinner = threading.Thread(target=spin, name="viscoadh-executor", daemon=True)
         spinner.start()
         try:
             yield context, executor
         finally:
-            executor.shutdown(timeout_sec=5.0)
+            # Stop spinning before anything is torn down: rclpy's Executor.shutdown does not
+            # wait for a spinning thread and destroys the guard condition that thread waits on
+            # (an AttributeError inside the executor), so the spinner must be gone first.
+            stop.set()
             spinner.join(timeout=5.0)
             node.destroy_node()
+            executor.shutdown(timeout_sec=5.0)
     finally:
         rclpy.try_shutdown(context=context)
         _set_environment(previous)
