@@ -30,6 +30,8 @@ import numpy as np
 
 STATUS_OK = 0
 STATUS_GROW = 1
+#: `_advance_rows` stopped before a row that starts from an idle contact (Python drops it).
+STATUS_IDLE = 2
 
 #: Edge motion codes written to ``out[OUT_MOTION]`` by `advance`.
 MOTION_NONE = 0
@@ -44,6 +46,11 @@ OUT_SUBSTEPS = 4
 OUT_STORED = 5
 OUT_MEMORY = 6
 OUT_SIZE = 7
+
+#: Columns of `_advance_rows`'s per-row output: the `out` slots, then the edge gaps.
+ROW_GAP_OUTSIDE = OUT_SIZE
+ROW_GAP_INSIDE = OUT_SIZE + 1
+ROW_SIZE = OUT_SIZE + 2
 
 # Substep attempts per `advance` after which the edge-motion limit is dropped for the rest of
 # the step: a guard (never reached in the test suite) so that an edge criterion flipping back
@@ -544,6 +551,88 @@ def _advance(
     out[OUT_STORED] = _stored_energy(a, d1, wl, wsum, dx, g_c, gf, df, e0, e_kelvin, steady)
     out[OUT_MEMORY] = _memory_peak(wsum)
     return STATUS_OK
+
+
+@numba.njit(cache=True, nogil=True)
+def _advance_rows(
+    wl,
+    wsum,
+    scratch,
+    dx,
+    g_c,
+    gf,
+    gint,
+    gmin,
+    df,
+    e0,
+    c_crit,
+    reach,
+    p,
+    p_inv,
+    lam,
+    beta,
+    rate,
+    kap,
+    e_kelvin,
+    steady,
+    out,
+    backup,
+    a,
+    t_prev,
+    d_prev,
+    peak,
+    times,
+    depths,
+    first,
+    max_substep,
+    max_edge_move,
+    idle_limit,
+    rows,
+):
+    """`_advance` over rows ``first..`` of a depth history in one compiled loop.
+
+    Arguments: `Row.kernel_args`, ``backup`` (N, K) scratch for the memory before a row,
+    the state before row ``first`` (radius a, time, depth, largest |wsum| ``peak``), the
+    history ``times``/``depths`` (n,), the step's limits as `_advance` takes them and
+    ``idle_limit`` (m): a contact out of contact whose memory peak is within it is idle.
+    Row i of ``rows`` (n, ROW_SIZE) gets the ``out`` slots and the edge gaps with the
+    exterior and the interior memory at the new radius (`criterion_gap`).
+
+    Returns ``(i, status)``: all rows done (``i = n``, STATUS_OK), or stopped before row i
+    with STATUS_IDLE (idle above the surface: the caller drops the memory, as
+    ContactSimulator does) or STATUS_GROW (memory restored, wsum not: the caller
+    restores it by its own rule, grows the domain and calls again from row i).
+    """
+    n = wl.shape[0]
+    for i in range(first, times.shape[0]):
+        d1 = depths[i]
+        if a <= 0.0 and peak <= idle_limit and d1 < 0.0 and d_prev < 0.0:
+            return i, STATUS_IDLE
+        for j in range(n):
+            for k in range(wl.shape[1]):
+                backup[j, k] = wl[j, k]
+        status = _advance(
+            wl, wsum, scratch, dx, g_c, gf, gint, gmin, df, e0, c_crit, reach, p, p_inv, lam, beta,
+            rate, kap, e_kelvin, steady, out, a, d_prev, d1, times[i] - t_prev, max_substep,
+            max_edge_move,
+        )
+        if status != STATUS_OK:
+            for j in range(n):
+                for k in range(wl.shape[1]):
+                    wl[j, k] = backup[j, k]
+            return i, status
+        a = out[OUT_RADIUS]
+        peak = out[OUT_MEMORY]
+        for k in range(OUT_SIZE):
+            rows[i, k] = out[k]
+        if a > 0.0:
+            # Only a contact's pinned edge needs them (the phase); none without contact.
+            n_in = _interior_count(a, dx, n)
+            rows[i, ROW_GAP_OUTSIDE] = _h(a, d1, wsum, n_in, n - 1, dx, g_c, gf, df, c_crit, 0.0)
+            rows[i, ROW_GAP_INSIDE] = _h(a, d1, wsum, 0, n_in - 1, dx, g_c, gf, df, c_crit, kap)
+        t_prev = times[i]
+        d_prev = d1
+    return times.shape[0], STATUS_OK
 
 
 @numba.njit(cache=True, nogil=True)

@@ -102,9 +102,10 @@ def simulate_history(
         )
     simulator = ContactSimulator(contact)
     simulator.reset(float(times[0]))
-    outputs = [
-        simulator.step(float(t), **{control_name: float(c)}) for t, c in zip(times, control, strict=True)
-    ]
+    if depth is not None:
+        # All rows in one compiled loop on the time-stepped path (same outputs as stepping).
+        return HistoryResult(**simulator.step_depths(times, control), model=simulator.model)
+    outputs = [simulator.step(float(t), force=float(c)) for t, c in zip(times, control, strict=True)]
     return HistoryResult.from_outputs(outputs, simulator.model)
 
 

@@ -404,6 +404,71 @@ class _TimeStepped:
         self._memory_peak = float(out[_kernels.OUT_MEMORY])
         return self.radius, float(out[_kernels.OUT_FORCE]), float(out[_kernels.OUT_WORK])
 
+    def advance_rows(
+        self, sim: ContactSimulator, times: np.ndarray, depths: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Advance through a depth history from ``sim``'s time and depth as `sim._trial`
+        then `advance` would row by row; returns per row (radius m, force N, work J, stored
+        energy J, edge gaps (n, 2) m: exterior, interior memory). Rows without a row (no
+        domain yet, or idle above the surface) cost nothing here either."""
+        n = times.size
+        rows = np.zeros((n, _kernels.ROW_SIZE))
+        t_prev, d_prev = sim.time, sim._depth
+        radius = sim.output.contact_radius
+        i = 0
+        while i < n:
+            if self.row is None and not self._ensure_row(max(d_prev, depths[i])):
+                # No domain and nothing to touch (row i is free, as `advance` finds): free
+                # rows until the indenter may touch.
+                touch = np.flatnonzero(np.maximum(depths[i + 1 :], depths[i:-1]) >= 0.0)
+                j = n if touch.size == 0 else i + 1 + int(touch[0])
+                self.substeps = 0
+                t_prev, d_prev, radius = float(times[j - 1]), float(depths[j - 1]), 0.0
+                i = j
+                continue
+            row = self.row
+            assert row is not None
+            peak = self._memory_peak
+            if peak is None:
+                peak = float(np.max(np.abs(row.wsum), initial=0.0))
+            backup = np.empty_like(row.wl)
+            i, status = _kernels._advance_rows(
+                *row.kernel_args,
+                backup,
+                radius,
+                t_prev,
+                d_prev,
+                peak,
+                times,
+                depths,
+                i,
+                self.numerics.max_substep,
+                self.numerics.max_edge_cells * row.dx,
+                self.numerics.idle_tolerance * row.length,
+                rows,
+            )
+            if i > 0:
+                last = rows[i - 1]
+                radius = float(last[_kernels.OUT_RADIUS])
+                t_prev, d_prev = float(times[i - 1]), float(depths[i - 1])
+                self.radius = radius
+                self.substeps = int(last[_kernels.OUT_SUBSTEPS])
+                self._stored = (d_prev, float(last[_kernels.OUT_STORED]))
+                self._memory_peak = float(last[_kernels.OUT_MEMORY])
+            if status == _kernels.STATUS_IDLE:
+                self.drop_memory()
+            elif status == _kernels.STATUS_GROW:
+                self.set_state((self.radius, row, row.wl.copy()))
+                self._grow(d_prev)
+        out = rows[:, : _kernels.OUT_SIZE]
+        return (
+            out[:, _kernels.OUT_RADIUS].copy(),
+            out[:, _kernels.OUT_FORCE].copy(),
+            out[:, _kernels.OUT_WORK].copy(),
+            out[:, _kernels.OUT_STORED].copy(),
+            rows[:, _kernels.ROW_GAP_OUTSIDE :].copy(),
+        )
+
     def stored_energy(self, depth: float) -> float:
         if self.row is None:
             return 0.0
@@ -460,6 +525,19 @@ class _TimeStepped:
         self.row = None
         self._stored = None
         self._memory_peak = None
+
+
+def _columns(outputs: list[StepOutput]) -> dict[str, np.ndarray]:
+    """One array per StepOutput field (phase uint8, flags bool) from a list of outputs."""
+    dtypes = {"phase": np.uint8, "scale_separation_ok": np.bool_, "unstable": np.bool_}
+    return {
+        name: np.array([getattr(o, name) for o in outputs], dtype=dtypes.get(name, np.float64))
+        for name in STEP_OUTPUT_FIELDS
+    }
+
+
+def _empty_columns() -> dict[str, np.ndarray]:
+    return _columns([])
 
 
 def _modal_chain(e0: float, e_kelvin: np.ndarray, eta_kelvin: np.ndarray) -> tuple[np.ndarray, ...]:
@@ -599,6 +677,81 @@ class ContactSimulator:
         if self._held_force is not None:
             return self.step(time, force=self._held_force)
         return self.step(time, depth=self._depth)
+
+    def step_depths(self, times: np.ndarray, depths: np.ndarray) -> dict[str, np.ndarray]:
+        """``step(times[i], depth=depths[i])`` for every i in turn, the time-stepped rows in
+        one compiled loop (`_kernels._advance_rows`); the outputs equal row-by-row stepping.
+
+        times: s, shape (n,), non-decreasing, from `time` on; depths: m, shape (n,). Returns
+        one array per `StepOutput` field (shape (n,); phase uint8, flags bool); the
+        simulator ends in the state of the last row, as after stepping. Nothing changes on
+        bad input.
+        """
+        t = np.ascontiguousarray(times, dtype=np.float64)
+        d = np.ascontiguousarray(depths, dtype=np.float64)
+        if t.ndim != 1 or t.shape != d.shape:
+            raise InputError(f"times and depths must be 1-D of one length (got {t.shape}, {d.shape})")
+        for name, values in (("time", t), ("depth", d)):
+            bad = np.flatnonzero(~np.isfinite(values))
+            if bad.size:
+                raise InputError(f"{name}[{int(bad[0])}] must be finite (got {values[bad[0]]!r})")
+        if t.size and (t[0] < self._time or np.any(np.diff(t) < 0.0)):
+            raise InputError("time must not go backwards (times must be non-decreasing from the current time)")
+        if t.size == 0:
+            return _empty_columns()
+        if isinstance(self._model, _TimeStepped):
+            radius, force, work, stored, gaps = self._model.advance_rows(self, t, d)
+        else:
+            outputs = [self.step(float(ti), depth=float(di)) for ti, di in zip(t, d, strict=True)]
+            return _columns(outputs)
+        physics = self.physics
+        r0 = np.concatenate(([self._output.contact_radius], radius[:-1]))
+        dt = np.diff(t, prepend=self._time)
+        energy_input = np.cumsum(np.concatenate(([self._energy_input], work)))[1:]
+        g = np.asarray(physics.profile.g(radius), dtype=np.float64)
+        tol = 1e-9 * (np.abs(d) + physics.c_crit * np.sqrt(radius) + g)
+        pinned = np.where(
+            gaps[:, 0] >= -tol, Phase.INDENTING, np.where(gaps[:, 1] <= tol, Phase.DETACHING, Phase.STICKING)
+        )
+        phase = np.where(
+            radius <= 0.0,
+            Phase.NO_CONTACT,
+            np.where(radius > r0, Phase.INDENTING, np.where(radius < r0, Phase.DETACHING, pinned)),
+        ).astype(np.uint8)
+        moving = dt > 0.0
+        edge_speed = np.where(moving, (radius - r0) / np.where(moving, dt, 1.0), 0.0)
+        u = d - g
+        in_contact = radius > 0.0
+        effective = np.where(
+            in_contact & (u < 0.0),
+            physics.e_relaxed * u * u / (2.0 * math.pi * np.where(in_contact, radius, 1.0)),
+            0.0,
+        )
+        dissipated = energy_input - stored + physics.work_of_adhesion * math.pi * radius * radius
+        v_c1, v_c2 = physics.critical_speeds
+        ok = (edge_speed == 0.0) | (np.abs(edge_speed) >= np.where(edge_speed > 0.0, v_c1, v_c2))
+        columns = {
+            "time": t,
+            "depth": d,
+            "force": force,
+            "contact_radius": radius,
+            "phase": phase,
+            "edge_speed": edge_speed,
+            "effective_work_of_adhesion": effective,
+            "energy_input": energy_input,
+            "energy_dissipated": dissipated,
+            "scale_separation_ok": ok,
+            "unstable": np.zeros(t.size, dtype=np.bool_),
+        }
+        self._time, self._depth = float(t[-1]), float(d[-1])
+        self._energy_input = float(energy_input[-1])
+        self._held_force = None
+        self._output = StepOutput(
+            *(columns[name][-1].item() for name in STEP_OUTPUT_FIELDS[:4]),
+            Phase(int(phase[-1])),
+            *(columns[name][-1].item() for name in STEP_OUTPUT_FIELDS[5:]),
+        )
+        return columns
 
     def _trial(self, time: float, depth: float) -> tuple[float, float, float]:
         """Advance the model (only) from the current state to (time, depth); returns
