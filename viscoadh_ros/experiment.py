@@ -254,10 +254,20 @@ def choose_contact(scene: SceneConfig, contact: str | None, input_topic: str | N
 class ModelRun:
     """The model over an experiment: outputs at the inputs, force at the measured stamps."""
 
-    input_outputs: list[StepOutput]  # (n,) one per input
+    input_columns: dict[str, NDArray]  # StepOutput field -> (n,) one value per input
     model_force: NDArray[np.float64]  # (m,) N, at Experiment.measured_ns
     wall_time: float  # s spent simulating
     model: str  # ContactSimulator.model: "closed_form" or "time_stepped"
+
+    @property
+    def input_outputs(self) -> list[StepOutput]:
+        """One StepOutput per input (built from `input_columns`)."""
+        from viscoadh_ros.core.simulator import STEP_OUTPUT_FIELDS, Phase, StepOutput
+
+        columns = [self.input_columns[name].tolist() for name in STEP_OUTPUT_FIELDS]
+        phase = STEP_OUTPUT_FIELDS.index("phase")
+        columns[phase] = [Phase(p) for p in columns[phase]]
+        return [StepOutput(*values) for values in zip(*columns, strict=True)]
 
 
 def run_model(
@@ -268,37 +278,86 @@ def run_model(
 ) -> ModelRun:
     """Run ``contact``'s model over ``experiment`` from a fresh state (the node's event loop).
 
-    ``progress(k)`` is called with the number of events done since the last call.
+    Every event under depth control (a depth input, or a measured stamp while a depth is
+    held: `ContactSimulator.advance` then steps to that time holding the depth) runs in one
+    `ContactSimulator.step_depths` call per stretch between force inputs; force inputs and
+    the stamps they hold run event by event. ``progress(k)`` is called with the number of
+    events done since the last call.
     """
     from viscoadh_ros.core.simulator import (
+        STEP_OUTPUT_FIELDS,
         ContactSimulator,  # numba: loaded only to simulate
     )
 
     n, m = experiment.input_ns.size, experiment.measured_ns.size
     stamps = np.concatenate([experiment.input_ns, experiment.measured_ns])
-    kinds = np.concatenate([np.zeros(n, np.int8), np.ones(m, np.int8)])
+    is_input = np.concatenate([np.ones(n, np.bool_), np.zeros(m, np.bool_)])
     index = np.concatenate([np.arange(n), np.arange(m)])
     # By stamp; at equal stamps in recording order (see the module docstring).
     order = np.lexsort((np.concatenate([experiment.input_order, experiment.measured_order]), stamps))
-    times = experiment.time(stamps)
+    times, is_input, index = experiment.time(stamps)[order], is_input[order], index[order]
+    # The control each event runs under: an input's own, a measured stamp the last input's
+    # (depth 0 before the first input: a fresh simulator holds its depth).
+    last_input = np.maximum.accumulate(np.where(is_input, np.arange(order.size), -1))
+    seen = last_input >= 0
+    held_mode = np.full(order.size, DEPTH, dtype=np.uint8)
+    held_mode[seen] = experiment.input_mode[index[last_input[seen]]]
+    held_value = np.zeros(order.size)
+    held_value[seen] = experiment.input_value[index[last_input[seen]]]
     sim = ContactSimulator(contact)
-    outputs: list[StepOutput] = [None] * n  # type: ignore[list-item]
+    columns = {name: np.empty(n, dtype=dtype) for name, dtype in _column_dtypes(STEP_OUTPUT_FIELDS).items()}
     model_force = np.empty(m)
     started = wallclock.perf_counter()
-    batch = max(1, order.size // 200)
-    for k, event in enumerate(order):
-        t = max(float(times[event]), sim.time)
-        i = int(index[event])
-        if kinds[event] == 0:
-            key = "depth" if experiment.input_mode[i] == DEPTH else "force"
-            outputs[i] = sim.step(t, **{key: float(experiment.input_value[i])})
+    # Stretches of consecutive events of one control mode.
+    bounds = np.flatnonzero(np.diff(held_mode.astype(np.int8))) + 1
+    for lo, hi in zip(np.concatenate(([0], bounds)), np.concatenate((bounds, [order.size])), strict=True):
+        if held_mode[lo] == DEPTH:
+            _depth_stretch(sim, times[lo:hi], is_input[lo:hi], index[lo:hi], held_value[lo:hi], columns, model_force)
         else:
-            model_force[i] = (sim.advance(t) if t > sim.time else sim.output).force
-        if progress is not None and (k + 1) % batch == 0:
-            progress(batch)
-    if progress is not None and order.size % batch:
-        progress(order.size % batch)
-    return ModelRun(outputs, model_force, wallclock.perf_counter() - started, sim.model)
+            for k in range(lo, hi):
+                t, i = max(float(times[k]), sim.time), int(index[k])
+                if is_input[k]:
+                    output = sim.step(t, force=float(experiment.input_value[i]))
+                    for name in STEP_OUTPUT_FIELDS:
+                        columns[name][i] = getattr(output, name)
+                else:
+                    model_force[i] = (sim.advance(t) if t > sim.time else sim.output).force
+        if progress is not None:
+            progress(int(hi - lo))
+    return ModelRun(columns, model_force, wallclock.perf_counter() - started, sim.model)
+
+
+def _column_dtypes(names: tuple[str, ...]) -> dict[str, type]:
+    special = {"phase": np.uint8, "scale_separation_ok": np.bool_, "unstable": np.bool_}
+    return {name: special.get(name, np.float64) for name in names}
+
+
+def _depth_stretch(
+    sim: Any,
+    times: NDArray[np.float64],
+    is_input: NDArray[np.bool_],
+    index: NDArray[np.int64],
+    depth: NDArray[np.float64],
+    columns: dict[str, NDArray],
+    model_force: NDArray[np.float64],
+) -> None:
+    """Run events under depth control in one `step_depths` call: every input steps; a
+    measured stamp steps to its time holding the depth when time has passed (`advance`),
+    else reads the last output. Writes the inputs' columns and the measured forces."""
+    before = sim.output.force
+    times = np.maximum(times, sim.time)
+    previous = np.concatenate(([sim.time], times[:-1]))
+    steps = is_input | (times > previous)
+    result = sim.step_depths(times[steps], depth[steps])
+    # Each event's force: its own step's, or the last step's before it.
+    last_step = np.maximum.accumulate(np.where(steps, np.cumsum(steps) - 1, -1))
+    force = np.where(last_step >= 0, result["force"][np.maximum(last_step, 0)], before)
+    measured = ~is_input
+    model_force[index[measured]] = force[measured]
+    inputs = index[is_input]
+    input_rows = (np.cumsum(steps) - 1)[is_input]
+    for name, values in result.items():
+        columns[name][inputs] = values[input_rows]
 
 
 @dataclass(frozen=True)
