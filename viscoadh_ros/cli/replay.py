@@ -138,7 +138,6 @@ def _write_output(
     The messages are those of ``ros.conversions.contact_state`` / ``wrench``, serialised in
     bulk (io/cdr.py): one message object per output cost more than the simulation.
     """
-    from operator import attrgetter
 
     import numpy as np
 
@@ -158,7 +157,7 @@ def _write_output(
         "scale_separation_ok",
         "unstable",
     ]
-    rows = np.array(list(map(attrgetter(*fields), run.input_outputs)), dtype=np.float64)
+    rows = np.column_stack([run.input_columns[name] for name in fields]).astype(np.float64)
     columns = dict(zip(fields, rows.T, strict=True))
     count = rows.shape[0]
     state = {
