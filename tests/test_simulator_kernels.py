@@ -178,8 +178,12 @@ def test_wrappers_reject_bad_input_before_numba() -> None:
         _kernels.kelvin_update(row, row.elements + 1, 0.0, 0.0, 1.0)
 
 
-def test_warm_up_runs_every_kernel() -> None:
+def test_warm_up_compiles_every_kernel_python_calls() -> None:
+    """The kernels that simulator code calls from Python (directly or through the public
+    wrappers) are compiled by `warm_up`, so a node that warms up never compiles mid-run."""
     _kernels.warm_up()
+    for name in ("_advance", "_advance_rows", "_force", "_stored_energy", "_kelvin_update", "_remap"):
+        assert getattr(_kernels, name).signatures, f"warm_up() left {name} uncompiled"
 
 
 @pytest.mark.parametrize("chain", ["standard", "three"])

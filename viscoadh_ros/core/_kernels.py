@@ -1076,3 +1076,20 @@ def warm_up() -> None:
     criterion_gap(row, 0.3, 0.1, 0.3, interior=True)
     kelvin_update(row, 2, 0.0, 0.1, 0.01)
     remap_memory(row, 0.3, 0.1, 3, 2.0)
+    times = np.array([0.0, 0.1, 0.2])
+    depths = np.array([0.0, 0.3, 0.1])
+    _advance_rows(
+        *row.kernel_args,
+        np.empty_like(row.wl),
+        0.0,
+        0.0,
+        0.0,
+        0.0,
+        times,
+        depths,
+        1,
+        0.0,
+        0.25,
+        0.0,
+        np.zeros((times.size, ROW_SIZE)),
+    )
