@@ -7,9 +7,9 @@ import math
 
 import numpy as np
 import pytest
+from scenes import one_contact
 
 from viscoadh_ros.core import reference
-from viscoadh_ros.core.config import SceneConfig
 from viscoadh_ros.core.errors import ConfigError
 from viscoadh_ros.core.simulator import ContactSimulator, Phase
 
@@ -20,21 +20,14 @@ MODELS = ["closed_form", "time_stepped"]
 
 
 def make_contact(indenter: dict, *, work: float = 0.0, model: str = "auto", kelvin=(), viscosities=()):
-    material = {"glass_shear_modulus": G0}
-    if kelvin:
-        material.update(kelvin_shear_moduli=list(kelvin), kelvin_viscosities=list(viscosities))
-    scene = SceneConfig.from_dict(
-        {
-            "contacts": ["c"],
-            "c": {
-                "indenter": indenter,
-                "material": material,
-                "adhesion": {"work_of_adhesion": work},
-                "numerics": {"model": model},
-            },
-        }
+    return one_contact(
+        indenter,
+        glass_shear_modulus=G0,
+        kelvin=kelvin,
+        viscosities=viscosities,
+        work=work,
+        numerics={"model": model},
     )
-    return scene.contact("c")
 
 
 def run_depth(contact, depth: np.ndarray, dt: float = 1e-3):

@@ -7,9 +7,9 @@ import math
 import naive
 import numpy as np
 import pytest
+from scenes import one_contact
 
 from viscoadh_ros.core import _kernels
-from viscoadh_ros.core.config import SceneConfig
 from viscoadh_ros.core.simulator import ContactSimulator
 
 
@@ -18,22 +18,8 @@ def make_contact(
 ):
     """One contact through the scene loader (radius 1 mm sphere unless told otherwise)."""
     indenter = {"shape": shape, **({"radius": 1e-3} if shape in ("sphere", "flat_punch") else {}), **indenter}
-    material = {"glass_shear_modulus": 1e6}
-    if kelvin:
-        material.update(kelvin_shear_moduli=list(kelvin), kelvin_viscosities=list(viscosities))
     numerics = {"model": model, **({"elements": elements} if elements else {})}
-    scene = SceneConfig.from_dict(
-        {
-            "contacts": ["c"],
-            "c": {
-                "indenter": indenter,
-                "material": material,
-                "adhesion": {"work_of_adhesion": work},
-                "numerics": numerics,
-            },
-        }
-    )
-    return scene.contact("c")
+    return one_contact(indenter, kelvin=kelvin, viscosities=viscosities, work=work, numerics=numerics)
 
 
 CHAINS = {
@@ -189,7 +175,9 @@ def test_warm_up_compiles_every_kernel_python_calls() -> None:
 @pytest.mark.parametrize("chain", ["standard", "three"])
 @pytest.mark.parametrize("seed", range(4))
 @pytest.mark.parametrize("depth", [-3e-6, -1e-6, 0.0, 1e-6])
-def test_first_touch_block_skip_finds_the_first_touching_fine_point(chain: str, seed: int, depth: float) -> None:
+def test_first_touch_block_skip_finds_the_first_touching_fine_point(
+    chain: str, seed: int, depth: float
+) -> None:
     """The block-skipping first-touch search returns the same fine point as a point-by-point
     scan of ``d - g - w >= 0`` (exterior memory interpolated as `naive.side_values`)."""
     row = make_row(chain, seed=seed)

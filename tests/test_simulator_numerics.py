@@ -6,8 +6,9 @@ import math
 
 import numpy as np
 import pytest
+from scenes import one_contact
 
-from viscoadh_ros.core.config import NumericsConfig, SceneConfig
+from viscoadh_ros.core.config import NumericsConfig
 from viscoadh_ros.core.errors import ConfigError
 from viscoadh_ros.core.presets import PRESET_NAMES, preset, resolve_numerics
 from viscoadh_ros.core.simulator import ContactSimulator
@@ -57,20 +58,9 @@ def test_bad_numerics_name_the_key(field: str, value) -> None:
 
 
 def contact(work: float, kelvin=()):
-    material = {"glass_shear_modulus": 1e6}
-    if kelvin:
-        material.update(kelvin_shear_moduli=list(kelvin), kelvin_viscosities=[1e3] * len(kelvin))
-    scene = SceneConfig.from_dict(
-        {
-            "contacts": ["c"],
-            "c": {
-                "indenter": {"shape": "sphere", "radius": 1e-3},
-                "material": material,
-                "adhesion": {"work_of_adhesion": work},
-            },
-        }
+    return one_contact(
+        {"shape": "sphere", "radius": 1e-3}, kelvin=kelvin, viscosities=[1e3] * len(kelvin), work=work
     )
-    return scene.contact("c")
 
 
 @pytest.mark.parametrize("kelvin", [(), (1e5,)])

@@ -9,9 +9,9 @@ import math
 import numpy as np
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from scenes import one_contact
 
 from viscoadh_ros.core import reference
-from viscoadh_ros.core.config import SceneConfig
 from viscoadh_ros.core.history import simulate_history
 from viscoadh_ros.core.rheology import CreepElement
 
@@ -22,22 +22,14 @@ G0 = 1e6
 
 
 def make_contact(*, radius, kelvin, viscosities, work, elements=0, shape="sphere"):
-    scene = SceneConfig.from_dict(
-        {
-            "contacts": ["c"],
-            "c": {
-                "indenter": {"shape": shape, "radius": radius},
-                "material": {
-                    "glass_shear_modulus": G0,
-                    "kelvin_shear_moduli": list(kelvin),
-                    "kelvin_viscosities": list(viscosities),
-                },
-                "adhesion": {"work_of_adhesion": work},
-                "numerics": {"model": "time_stepped", **({"elements": elements} if elements else {})},
-            },
-        }
+    return one_contact(
+        {"shape": shape, "radius": radius},
+        glass_shear_modulus=G0,
+        kelvin=kelvin,
+        viscosities=viscosities,
+        work=work,
+        numerics={"model": "time_stepped", **({"elements": elements} if elements else {})},
     )
-    return scene.contact("c")
 
 
 def chain(log_ratio: float, log_tau: float, spread: float) -> tuple[list[float], list[float]]:

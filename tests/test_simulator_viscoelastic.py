@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from scenes import one_contact
 
 from viscoadh_ros.core import reference
 from viscoadh_ros.core.config import SceneConfig
@@ -28,21 +29,14 @@ R = 1e-3
 
 
 def make_contact(*, kelvin=(G1,), viscosities=(TAU * (G0 + G1),), work=0.0, shape="sphere", **numerics):
-    material = {"glass_shear_modulus": G0}
-    if kelvin:
-        material.update(kelvin_shear_moduli=list(kelvin), kelvin_viscosities=list(viscosities))
-    scene = SceneConfig.from_dict(
-        {
-            "contacts": ["c"],
-            "c": {
-                "indenter": {"shape": shape, "radius": R},
-                "material": material,
-                "adhesion": {"work_of_adhesion": work},
-                "numerics": {"model": "time_stepped", **numerics},
-            },
-        }
+    return one_contact(
+        {"shape": shape, "radius": R},
+        glass_shear_modulus=G0,
+        kelvin=kelvin,
+        viscosities=viscosities,
+        work=work,
+        numerics={"model": "time_stepped", **numerics},
     )
-    return scene.contact("c")
 
 
 @pytest.mark.parametrize(

@@ -16,9 +16,9 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from scenes import one_contact
 
 from viscoadh_ros.core import reference
-from viscoadh_ros.core.config import SceneConfig
 from viscoadh_ros.core.rheology import CreepElement
 from viscoadh_ros.core.simulator import ContactSimulator, StepOutput
 
@@ -39,24 +39,17 @@ def make_contact(
     elements: int = 0,
 ) -> Any:
     """A sphere contact through the one scene loader; elements 0 keeps the preset's count."""
-    material: dict[str, Any] = {"glass_shear_modulus": glass}
-    if kelvin:
-        material.update(kelvin_shear_moduli=kelvin, kelvin_viscosities=viscosities)
     numerics: dict[str, Any] = {"model": "time_stepped"}
     if elements:
         numerics["elements"] = elements
-    scene = SceneConfig.from_dict(
-        {
-            "contacts": ["x"],
-            "x": {
-                "indenter": {"shape": "sphere", "radius": radius},
-                "material": material,
-                "adhesion": {"work_of_adhesion": work},
-                "numerics": numerics,
-            },
-        }
+    return one_contact(
+        {"shape": "sphere", "radius": radius},
+        glass_shear_modulus=glass,
+        kelvin=kelvin,
+        viscosities=viscosities,
+        work=work,
+        numerics=numerics,
     )
-    return scene.contact("x")
 
 
 def run(contact: Any, time: np.ndarray, depth: np.ndarray) -> list[StepOutput]:
