@@ -112,6 +112,20 @@ def test_bag_reader_gives_scene_and_messages(tmp_path: Path) -> None:
     assert [m.msg.data for m in msgs if m.topic == "/depth"] == [1e-6 * i for i in range(20)]
 
 
+def test_handed_over_messages_are_written_as_copied_ones(tmp_path: Path) -> None:
+    """A handed-over message is serialised on the writer thread and reads back as the same
+    message; one recorded by copy is serialised at once, so a later change does not leak."""
+    with McapRecorder(tmp_path / "h.mcap") as rec:
+        copied = _wrench(3)
+        rec.record("/copied", copied, 1)
+        copied.wrench.force.z = 99.0
+        rec.record("/handed", _wrench(3), 2, handed_over=True)
+    assert rec.error is None and rec.written == 2, f"writer failed: {rec.error!r}"
+    msgs = {m.topic: m.msg for m in Bag(tmp_path / "h.mcap").messages(["/copied", "/handed"])}
+    for topic in ("/copied", "/handed"):
+        assert msgs[topic] == _wrench(3), f"{topic}: read back {msgs[topic]}"
+
+
 def test_full_queue_drops_and_counts(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     entered, release = threading.Event(), threading.Event()
     original = mcap_log._File.write

@@ -74,7 +74,8 @@ class TopicQos:
 class _Item:
     topic: str
     type_name: str
-    data: bytes
+    # CDR bytes, or the message itself when the caller handed it over (serialised by the writer).
+    data: Any
     stamp_ns: int
 
 
@@ -176,11 +177,12 @@ class _File:
 
     def write(self, item: _Item, qos: TopicQos) -> None:
         channel = self.channel(item.topic, item.type_name, qos)
+        data = item.data if isinstance(item.data, bytes) else serialize_message(item.data)
         self.writer.add_message(
             channel,
             log_time=item.stamp_ns,
             publish_time=item.stamp_ns,
-            data=item.data,
+            data=data,
             sequence=self.counts[item.topic],
         )
         self.counts[item.topic] += 1
@@ -206,7 +208,8 @@ class McapRecorder:
     """Record ROS 2 messages to MCAP from a background thread.
 
     ``record()`` serialises the message (so later changes to the object do not leak into the
-    log) and puts it on a bounded queue; when the queue is full the message is dropped and
+    log), or with ``handed_over=True`` queues the object itself for the writer thread to
+    serialise (off the caller's thread), and puts it on a bounded queue; when the queue is full the message is dropped and
     :attr:`dropped` counts it. The writer thread owns the files.
 
     Args:
@@ -288,8 +291,13 @@ class McapRecorder:
         """The exception that stopped the writer thread, if any (recording then drops)."""
         return self._error
 
-    def record(self, topic: str, msg: Any, stamp_ns: int) -> bool:
+    def record(self, topic: str, msg: Any, stamp_ns: int, *, handed_over: bool = False) -> bool:
         """Queue ``msg`` for ``topic`` with log time ``stamp_ns`` (node clock, ns).
+
+        ``handed_over=True``: the caller gives ``msg`` away and never changes it again (e.g. a
+        message built for one publish); it is serialised on the writer thread, which saves the
+        caller ~5-15 us per message. Otherwise it is serialised here, so later changes to the
+        object do not leak into the log.
 
         Never blocks. Returns False (and counts a drop) when the queue is full, the writer
         failed or the recorder is closed.
@@ -302,7 +310,8 @@ class McapRecorder:
         if type_name is None:
             type_name = self._types[cls] = type_name_of(cls)
         try:
-            self._queue.put_nowait(_Item(topic, type_name, serialize_message(msg), int(stamp_ns)))
+            data = msg if handed_over else serialize_message(msg)
+            self._queue.put_nowait(_Item(topic, type_name, data, int(stamp_ns)))
         except queue.Full:
             self._dropped += 1
             return False

@@ -67,9 +67,10 @@ GIL_SWITCH_INTERVAL_S = 1e-4
 class Recorder(Protocol):
     """What the node hands every message it receives and publishes to (MCAP logging)."""
 
-    def record(self, topic: str, msg: Any, stamp_ns: int) -> bool:
+    def record(self, topic: str, msg: Any, stamp_ns: int, *, handed_over: bool = False) -> bool:
         """Queue ``msg`` seen on ``topic`` at log time ``stamp_ns`` (node clock); never blocks.
-        False when the message was dropped (full queue)."""
+        ``handed_over``: the caller never changes ``msg`` again, so the recorder may serialise
+        it later on its own thread. False when the message was dropped (full queue)."""
 
     def close(self) -> None:
         """Finish the log."""
@@ -518,9 +519,14 @@ class ViscoadhNode(Node):
                 contact.clock_jumped_locked(-jump.delta.nanoseconds * 1e-9)
 
     def record(self, topic: str, msg: Any, stamp_ns: int) -> None:
-        """Hand a received or published message to the recorder, if logging is on."""
+        """Hand a received or published message to the recorder, if logging is on.
+
+        The live path builds (or takes) a fresh message object per command and never changes it
+        after publishing it, so the message is handed over: serialised on the recorder's thread,
+        not on the live one.
+        """
         if self._recorder is not None:
-            self._recorder.record(topic, msg, stamp_ns)
+            self._recorder.record(topic, msg, stamp_ns, handed_over=True)
 
     def _publish_diagnostics(self) -> None:
         statuses = [contact.status() for contact in self.contacts.values()]
