@@ -32,7 +32,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.optimize import least_squares
+from scipy.optimize import OptimizeResult, least_squares
 
 from viscoadh_ros.core.errors import InputError
 from viscoadh_ros.experiment import Experiment, run_model
@@ -50,6 +50,8 @@ MAX_CONDITION = 1e6
 #: At 2 % the element steps' roughness passed for curvature: on tutorial 2's record a
 #: four-parameter fit stated G0 +-4.7 % while its cost was flat from 1.2e6 to 2.1e6 Pa.
 SECANT_STEP = 0.1
+#: Multiples of the start G0 that a fit of G0 with other parameters descends from (best kept).
+G0_START_FACTORS = (1.0, 0.5, 2.0)
 #: A change of the measured force between consecutive samples larger than this fraction of
 #: max|F| (and than 10 median changes) is a jump; JUMP_MARGIN samples either side are left out.
 JUMP_FRACTION = 0.1
@@ -186,8 +188,10 @@ def fit(
     measured = experiment.measured_force[usable]
     scale = float(np.max(np.abs(measured)))
 
-    def model(theta: NDArray[np.float64], names: Sequence[str]) -> NDArray[np.float64]:
-        trial = dict(values)
+    def model(
+        base: dict[str, float], theta: NDArray[np.float64], names: Sequence[str]
+    ) -> NDArray[np.float64]:
+        trial = dict(base)
         trial.update({n: float(math.exp(t)) for n, t in zip(names, theta, strict=True)})
         try:
             return run_model(with_parameters(contact, trial, kelvin), experiment).model_force[usable]
@@ -197,23 +201,40 @@ def fit(
 
     stage1 = [n for n in free if n != "work_of_adhesion"]
     compressive = measured > 0.0
-    if stage1 and "work_of_adhesion" in free and np.count_nonzero(compressive) > len(stage1) + 1:
-        x0 = np.log([values[n] for n in stage1])
-        first = least_squares(
-            lambda th: (model(th, stage1)[compressive] - measured[compressive]) / scale,
-            x0,
-            diff_step=1e-4,
-            x_scale=1.0,
+    staged = bool(stage1) and "work_of_adhesion" in free and np.count_nonzero(compressive) > len(stage1) + 1
+
+    def descend(start: dict[str, float]) -> tuple[OptimizeResult, dict[str, float]]:
+        """Both stages from ``start``: the optimum and every parameter's value there."""
+        start = dict(start)
+        if staged:
+            first = least_squares(
+                lambda th: (model(start, th, stage1)[compressive] - measured[compressive]) / scale,
+                np.log([start[n] for n in stage1]),
+                diff_step=1e-4,
+                x_scale=1.0,
+            )
+            start.update({n: float(math.exp(t)) for n, t in zip(stage1, first.x, strict=True)})
+        x0 = np.log([start[n] for n in free])
+        found = least_squares(
+            lambda th: (model(start, th, free) - measured) / scale, x0, diff_step=1e-4, x_scale=1.0
         )
-        values.update({n: float(math.exp(t)) for n, t in zip(stage1, first.x, strict=True)})
-    x0 = np.log([values[n] for n in free])
-    result = least_squares(lambda th: (model(th, free) - measured) / scale, x0, diff_step=1e-4, x_scale=1.0)
+        start.update({n: float(math.exp(t)) for n, t in zip(free, found.x, strict=True)})
+        return found, start
+
+    # The glass modulus shows only in the fastest parts of a record, so with the Kelvin chain
+    # free a descent can stop in a valley far from it: start also from G0 halved and doubled
+    # and keep the lowest cost.
+    factors = G0_START_FACTORS if "G0" in free and len(free) > 1 else (1.0,)
+    descents = [descend({**values, "G0": values["G0"] * f}) for f in factors]
+    result, values = min(descents, key=lambda d: d[0].cost)
     if not result.success:
         raise FitError(f"the fit did not converge: {result.message}")
-    values.update({n: float(math.exp(t)) for n, t in zip(free, result.x, strict=True)})
     secant = np.column_stack(
         [
-            (model(result.x + SECANT_STEP * e, free) - model(result.x - SECANT_STEP * e, free))
+            (
+                model(values, result.x + SECANT_STEP * e, free)
+                - model(values, result.x - SECANT_STEP * e, free)
+            )
             / (2 * SECANT_STEP * scale)
             for e in np.eye(len(free))
         ]
