@@ -16,6 +16,7 @@ different lengths in one batch) makes :func:`decode` return None, so callers fal
 
 from __future__ import annotations
 
+import struct
 from collections.abc import Mapping, Sequence
 
 import numpy as np
@@ -93,6 +94,40 @@ def _layout(type_name: str, frame_bytes: int) -> np.dtype:
             "itemsize": _HEADER + position,
         }
     )
+
+
+class Packer:
+    """CDR payloads of ``type_name`` with one ``frame_id``, one message at a time (a live path):
+    :meth:`pack` writes the stamp and the field values into a copy of a zeroed message built by
+    :func:`encode` (same layout), about 1-2 us against rclpy's conversion and serialisation.
+
+    ``fields``: the names :meth:`pack` takes after the stamp, in order (every field of the type).
+    """
+
+    _CODES = {"<i4": "i", "<u4": "I", "<f8": "d", "|u1": "B", "|b1": "?"}
+
+    def __init__(self, type_name: str, frame_id: str) -> None:
+        self.fields: tuple[str, ...] = tuple(name for name, _ in _FIELDS[type_name][1])
+        layout = _layout(type_name, len(frame_id.encode()))
+        self._stamped = _FIELDS[type_name][0]
+        self._template = encode(type_name, [0], frame_id, {})[0]
+        self._start = layout.fields[self.fields[0]][1]
+        codes, position = ["<"], self._start
+        for name in self.fields:
+            fmt, offset = layout.fields[name][:2]
+            codes.append("x" * (offset - position) + self._CODES[fmt.str])
+            position = offset + fmt.itemsize
+        self._values = struct.Struct("".join(codes))
+        self._stamp = struct.Struct("<iI")
+
+    def pack(self, stamp_ns: int, *values: float | int | bool) -> bytes:
+        """The payload at ``stamp_ns`` (ns >= 0; ignored for unstamped types) with ``values``
+        in the order of :attr:`fields`."""
+        buffer = bytearray(self._template)
+        if self._stamped:
+            self._stamp.pack_into(buffer, _HEADER, *divmod(stamp_ns, 1_000_000_000))
+        self._values.pack_into(buffer, self._start, *values)
+        return bytes(buffer)
 
 
 def decode(type_name: str, payloads: Sequence[bytes]) -> dict[str, NDArray] | None:
