@@ -6,6 +6,8 @@ import dataclasses
 import math
 
 import pytest
+from geometry_msgs.msg import WrenchStamped
+from rclpy.serialization import deserialize_message
 from viscoadh_msgs.msg import ContactState, IndentationCommand
 
 from viscoadh_ros.core.errors import InputError
@@ -75,3 +77,31 @@ def test_bad_command_names_the_field(msg: IndentationCommand, match: str) -> Non
 def test_command_selects_the_control_of_its_mode() -> None:
     msg = IndentationCommand(mode=IndentationCommand.FORCE, depth=math.nan, force=-1e-3)
     assert conversions.command_control(msg) == {"force": -1e-3}, "depth is unused in FORCE mode"
+
+
+@pytest.mark.parametrize("frame_id", ["", "a", "tip", "contact_frame"])
+def test_live_payloads_read_back_as_the_messages(frame_id: str) -> None:
+    """The node publishes and logs these bytes: they must deserialise to exactly the messages
+    contact_state/wrench build, whatever the frame id's length does to the CDR alignment."""
+    output = StepOutput(
+        time=1.5,
+        depth=-2e-6,
+        force=-3e-3,
+        contact_radius=4e-5,
+        phase=Phase.DETACHING,
+        edge_speed=-1e-4,
+        effective_work_of_adhesion=0.3,
+        energy_input=1e-9,
+        energy_dissipated=2e-10,
+        scale_separation_ok=False,
+        unstable=True,
+    )
+    stamp_ns = 1_795_352_880_799_998_059
+    common = {"model": "closed_form", "commands_received": 70_000, "commands_rejected": 3}
+    payloads = conversions.LivePayloads(frame_id)
+    state = deserialize_message(payloads.state(output, stamp_ns=stamp_ns, **common), ContactState)
+    expected = conversions.contact_state(output, stamp_ns=stamp_ns, frame_id=frame_id, **common)
+    assert state == expected, f"frame {frame_id!r}: {state} != {expected}"
+    wrench = deserialize_message(payloads.wrench(output, stamp_ns=stamp_ns), WrenchStamped)
+    expected_wrench = conversions.wrench(output, stamp_ns=stamp_ns, frame_id=frame_id)
+    assert wrench == expected_wrench, f"frame {frame_id!r}: {wrench} != {expected_wrench}"

@@ -48,6 +48,7 @@ from viscoadh_ros.core.config import ContactConfig, SceneConfig
 from viscoadh_ros.core.errors import ConfigError, InputError
 from viscoadh_ros.core.history import predict_pull_off, simulate_history
 from viscoadh_ros.core.simulator import ContactSimulator, StepOutput
+from viscoadh_ros.io import cdr
 from viscoadh_ros.io.mcap_log import McapRecorder
 from viscoadh_ros.ros import conversions, diagnostics, markers, parameters
 
@@ -71,6 +72,9 @@ class Recorder(Protocol):
         """Queue ``msg`` seen on ``topic`` at log time ``stamp_ns`` (node clock); never blocks.
         ``handed_over``: the caller never changes ``msg`` again, so the recorder may serialise
         it later on its own thread. False when the message was dropped (full queue)."""
+
+    def record_cdr(self, topic: str, type_name: str, payload: bytes, stamp_ns: int) -> bool:
+        """:meth:`record` for an already serialised ``type_name`` message."""
 
     def close(self) -> None:
         """Finish the log."""
@@ -240,30 +244,32 @@ class _Contact:
             ):
                 self.marker_pub.publish(marker)
 
-    def _state_locked(self, output: StepOutput, stamp_ns: int) -> ContactState:
-        return conversions.contact_state(
+    def _state_locked(self, output: StepOutput, stamp_ns: int) -> bytes:
+        """The ContactState at ``stamp_ns`` as its CDR payload (see LivePayloads)."""
+        return self.node.payloads.state(
             output,
             stamp_ns=stamp_ns,
-            frame_id=self.node.frame_id,
             model=self.simulator.model,
             commands_received=self.counters.commands_received,
             commands_rejected=self.counters.commands_rejected,
         )
 
-    def _publish(self, state: ContactState, output: StepOutput, stamp_ns: int, now_ns: int) -> None:
-        """Publish the state, and the wrench when it has subscribers; log what is published.
+    def _publish(self, state: bytes, output: StepOutput, stamp_ns: int, now_ns: int) -> None:
+        """Publish the state (a CDR payload), and the wrench when it has subscribers; log what
+        is published.
 
-        The wrench costs a message build and a publish per command (measured ~15% of the live
-        path): skipped while nobody reads it, except that an MCAP log keeps it for replays.
+        The wrench costs a payload and a publish per command: skipped while nobody reads it,
+        except that an MCAP log keeps it for replays.
         """
+        node = self.node
         self.state_pub.publish(state)
-        self.node.record(self.state_pub.topic_name, state, now_ns)
+        node.record_cdr(self.state_pub.topic_name, cdr.CONTACT_STATE, state, now_ns)
         listened = self.wrench_pub.get_subscription_count() > 0
-        if listened or self.node.logging:
-            wrench = conversions.wrench(output, stamp_ns=stamp_ns, frame_id=state.header.frame_id)
+        if listened or node.logging:
+            wrench = node.payloads.wrench(output, stamp_ns=stamp_ns)
             if listened:
                 self.wrench_pub.publish(wrench)
-            self.node.record(self.wrench_pub.topic_name, wrench, now_ns)
+            node.record_cdr(self.wrench_pub.topic_name, cdr.WRENCH, wrench, now_ns)
 
     def _reject_locked(self, reason: str, *, command: bool) -> None:
         self.counters.reject(reason, command=command)
@@ -472,6 +478,7 @@ class ViscoadhNode(Node):
         self.scene: SceneConfig = parameters.scene_from_node(self)
         parameters.declare_scene(self, self.scene)
         self.frame_id = self.scene.node.frame_id
+        self.payloads = conversions.LivePayloads(self.frame_id)
         self.markers_enabled = self.scene.node.markers_enabled
         # MCAP logging; None while logging is off. Opened before the endpoints exist, so the
         # log holds every command received and every state and wrench published.
@@ -528,6 +535,11 @@ class ViscoadhNode(Node):
         if self._recorder is not None:
             self._recorder.record(topic, msg, stamp_ns, handed_over=True)
 
+    def record_cdr(self, topic: str, type_name: str, payload: bytes, stamp_ns: int) -> None:
+        """Hand a published payload (CDR of a ``type_name`` message) to the recorder, if on."""
+        if self._recorder is not None:
+            self._recorder.record_cdr(topic, type_name, payload, stamp_ns)
+
     def _publish_diagnostics(self) -> None:
         statuses = [contact.status() for contact in self.contacts.values()]
         if self._recorder is not None:
@@ -579,6 +591,8 @@ class ViscoadhNode(Node):
             for contact in self.contacts.values():
                 contact.set_publish_rate(scene.node.publish_rate)
         self.frame_id = scene.node.frame_id
+        if self.payloads.frame_id != self.frame_id:
+            self.payloads = conversions.LivePayloads(self.frame_id)
         self.markers_enabled = scene.node.markers_enabled
         self.scene = scene
         return SetParametersResult(successful=True)
