@@ -124,6 +124,10 @@ class _Contact:
             callback_group=live,
         )
         self.timer = node.create_timer(1.0 / node.scene.node.publish_rate, self.on_timer, callback_group=live)
+        # Resolved names, read per message for the log (rclpy's topic_name asks rcl each time).
+        self.command_topic = self.subscription.topic_name
+        self.state_topic = self.state_pub.topic_name
+        self.wrench_topic = self.wrench_pub.topic_name
         services = node.services_group
         node.create_service(
             SimulateHistory,
@@ -175,7 +179,7 @@ class _Contact:
     def on_command(self, msg: IndentationCommand) -> None:
         """Step to the command's stamp and publish the state at that stamp, or reject."""
         now_ns = self.node.now_ns()
-        self.node.record(self.subscription.topic_name, msg, now_ns)
+        self.node.record(self.command_topic, msg, now_ns)
         stamp_ns = conversions.stamp_to_ns(msg.header.stamp) or now_ns
         with self.lock:
             self._check_clock_locked(now_ns)
@@ -263,13 +267,13 @@ class _Contact:
         """
         node = self.node
         self.state_pub.publish(state)
-        node.record_cdr(self.state_pub.topic_name, cdr.CONTACT_STATE, state, now_ns)
+        node.record_cdr(self.state_topic, cdr.CONTACT_STATE, state, now_ns)
         listened = self.wrench_pub.get_subscription_count() > 0
         if listened or node.logging:
             wrench = node.payloads.wrench(output, stamp_ns=stamp_ns)
             if listened:
                 self.wrench_pub.publish(wrench)
-            node.record_cdr(self.wrench_pub.topic_name, cdr.WRENCH, wrench, now_ns)
+            node.record_cdr(self.wrench_topic, cdr.WRENCH, wrench, now_ns)
 
     def _reject_locked(self, reason: str, *, command: bool) -> None:
         self.counters.reject(reason, command=command)
