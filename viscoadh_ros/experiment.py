@@ -312,7 +312,9 @@ def run_model(
     bounds = np.flatnonzero(np.diff(held_mode.astype(np.int8))) + 1
     for lo, hi in zip(np.concatenate(([0], bounds)), np.concatenate((bounds, [order.size])), strict=True):
         if held_mode[lo] == DEPTH:
-            _depth_stretch(sim, times[lo:hi], is_input[lo:hi], index[lo:hi], held_value[lo:hi], columns, model_force)
+            _depth_stretch(
+                sim, times[lo:hi], is_input[lo:hi], index[lo:hi], held_value[lo:hi], columns, model_force
+            )
         else:
             for k in range(lo, hi):
                 t, i = max(float(times[k]), sim.time), int(index[k])

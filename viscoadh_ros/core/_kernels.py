@@ -612,8 +612,32 @@ def _advance_rows(
             for k in range(wl.shape[1]):
                 backup[j, k] = wl[j, k]
         status = _advance(
-            wl, wsum, scratch, dx, g_c, gf, gint, gmin, df, e0, c_crit, reach, p, p_inv, lam, beta,
-            rate, kap, e_kelvin, steady, out, a, d_prev, d1, times[i] - t_prev, max_substep,
+            wl,
+            wsum,
+            scratch,
+            dx,
+            g_c,
+            gf,
+            gint,
+            gmin,
+            df,
+            e0,
+            c_crit,
+            reach,
+            p,
+            p_inv,
+            lam,
+            beta,
+            rate,
+            kap,
+            e_kelvin,
+            steady,
+            out,
+            a,
+            d_prev,
+            d1,
+            times[i] - t_prev,
+            max_substep,
             max_edge_move,
         )
         if status != STATUS_OK:
@@ -932,7 +956,13 @@ def advance(
     if dt < 0.0 or radius < 0.0 or max_edge_move <= 0.0 or not max_substep >= 0.0:
         raise ValueError("dt, radius and max_substep must be >= 0 and max_edge_move > 0")
     status = _advance(
-        *row.kernel_args, float(radius), float(d0), float(d1), float(dt), float(max_substep), float(max_edge_move)
+        *row.kernel_args,
+        float(radius),
+        float(d0),
+        float(d1),
+        float(dt),
+        float(max_substep),
+        float(max_edge_move),
     )
     return int(status), row.out
 
@@ -952,7 +982,17 @@ def locate_edge(row: Row, radius: float, depth: float) -> tuple[float, int, bool
     ``(new radius m, MOTION_* code, grow)``; grow asks for a larger domain."""
     _check_scalars(radius=radius, depth=depth)
     new_radius, motion, grow = _locate_edge(
-        float(radius), float(depth), row.wsum, row.dx, row.g_c, row.gf, row.gmin, row.df, row.c_crit, row.reach, row.kap
+        float(radius),
+        float(depth),
+        row.wsum,
+        row.dx,
+        row.g_c,
+        row.gf,
+        row.gmin,
+        row.df,
+        row.c_crit,
+        row.reach,
+        row.kap,
     )
     return float(new_radius), int(motion), bool(grow)
 

@@ -696,7 +696,9 @@ class ContactSimulator:
             if bad.size:
                 raise InputError(f"{name}[{int(bad[0])}] must be finite (got {values[bad[0]]!r})")
         if t.size and (t[0] < self._time or np.any(np.diff(t) < 0.0)):
-            raise InputError("time must not go backwards (times must be non-decreasing from the current time)")
+            raise InputError(
+                "time must not go backwards (times must be non-decreasing from the current time)"
+            )
         if t.size == 0:
             return _empty_columns()
         if isinstance(self._model, _TimeStepped):

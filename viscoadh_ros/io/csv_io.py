@@ -69,7 +69,8 @@ def read_history(path: str | Path) -> History:
             values[i, j] = number
         if i and values[i, 0] <= values[i - 1, 0]:
             raise InputError(
-                f"{name}:{line}: column 'time' must increase strictly ({row[0]} after {float(values[i - 1, 0])!r})"
+                f"{name}:{line}: column 'time' must increase strictly "
+                f"({row[0]} after {float(values[i - 1, 0])!r})"
             )
     return History(values[:, 0].copy(), control, values[:, 1].copy())
 
