@@ -143,20 +143,9 @@ def _write_output(
 
     from viscoadh_ros.io import cdr
     from viscoadh_ros.io.mcap_log import TopicData, write_mcap
-    from viscoadh_ros.ros.conversions import MODEL_CODES
+    from viscoadh_ros.ros.conversions import MODEL_CODES, STATE_OUTPUT_FIELDS
 
-    fields = [
-        "depth",
-        "force",
-        "contact_radius",
-        "phase",
-        "edge_speed",
-        "effective_work_of_adhesion",
-        "energy_input",
-        "energy_dissipated",
-        "scale_separation_ok",
-        "unstable",
-    ]
+    fields = list(STATE_OUTPUT_FIELDS)
     rows = np.column_stack([run.input_columns[name] for name in fields]).astype(np.float64)
     columns = dict(zip(fields, rows.T, strict=True))
     count = rows.shape[0]

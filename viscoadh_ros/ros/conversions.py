@@ -102,6 +102,22 @@ def wrench(output: StepOutput, *, stamp_ns: int, frame_id: str) -> WrenchStamped
     return msg
 
 
+#: The simulator outputs a ContactState carries, in message order (the model code and the
+#: command counters follow them); replay writes its columns in the same order.
+STATE_OUTPUT_FIELDS = (
+    "depth",
+    "force",
+    "contact_radius",
+    "phase",
+    "edge_speed",
+    "effective_work_of_adhesion",
+    "energy_input",
+    "energy_dissipated",
+    "scale_separation_ok",
+    "unstable",
+)
+
+
 class LivePayloads:
     """The live path's ContactState and WrenchStamped for one ``frame_id`` as CDR payloads,
     equal to :func:`contact_state` and :func:`wrench` serialised.
@@ -112,21 +128,7 @@ class LivePayloads:
     converts it to C and serialises it again.
     """
 
-    _STATE_FIELDS = (
-        "depth",
-        "force",
-        "contact_radius",
-        "phase",
-        "edge_speed",
-        "effective_work_of_adhesion",
-        "energy_input",
-        "energy_dissipated",
-        "scale_separation_ok",
-        "unstable",
-        "model",
-        "commands_received",
-        "commands_rejected",
-    )
+    _STATE_FIELDS = (*STATE_OUTPUT_FIELDS, "model", "commands_received", "commands_rejected")
 
     def __init__(self, frame_id: str) -> None:
         self.frame_id = frame_id
