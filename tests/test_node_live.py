@@ -19,11 +19,11 @@ from rosgraph_msgs.msg import Clock
 from std_srvs.srv import Trigger
 from viscoadh_msgs.msg import ContactState, IndentationCommand
 from viscoadh_msgs.srv import PredictPullOff, SimulateHistory
-from viscoadh_ros.core.history import simulate_history
 from visualization_msgs.msg import Marker
 
 from viscoadh_ros.core.config import SceneConfig
 from viscoadh_ros.core.errors import ConfigError
+from viscoadh_ros.core.history import simulate_history
 from viscoadh_ros.core.simulator import ContactSimulator
 from viscoadh_ros.ros.conversions import ns_to_stamp
 from viscoadh_ros.ros.node import ViscoadhNode
@@ -339,3 +339,39 @@ def test_diagnostics_and_markers(ros_context: Any, ros_executor: Any, spin_until
     assert elastic["commands_received"] == "1" and elastic["commands_rejected"] == "1"
     disc = next(m for m in marks if m.type == Marker.CYLINDER and m.action == Marker.ADD)
     assert disc.scale.x > 0.0, "contact disc drawn with the contact diameter"
+
+
+def test_namespace_and_remapping_apply_as_for_any_node(
+    ros_context: Any, ros_executor: Any, spin_until: Any
+) -> None:
+    """Every name is relative: a namespace moves them all and a remap renames one."""
+    from rclpy.node import Node
+
+    overrides = [Parameter(name, value=value) for name, value in SCENE.items()]
+    viscoadh = ViscoadhNode(
+        context=ros_context,
+        parameter_overrides=overrides,
+        namespace="left_hand",
+        cli_args=["--ros-args", "-r", "elastic/wrench:=elastic/force"],
+    )
+    ros_executor.add_node(viscoadh)
+    probe = Node("probe", context=ros_context)
+    ros_executor.add_node(probe)
+    states: list[ContactState] = []
+    wrenches: list[WrenchStamped] = []
+    pub = probe.create_publisher(IndentationCommand, "/left_hand/elastic/indentation", 10)
+    probe.create_subscription(ContactState, "/left_hand/elastic/state", states.append, 10)
+    probe.create_subscription(WrenchStamped, "/left_hand/elastic/force", wrenches.append, 10)
+    pull_off = probe.create_client(PredictPullOff, "/left_hand/elastic/predict_pull_off")
+    assert spin_until(
+        ros_executor,
+        lambda: pub.get_subscription_count() > 0 and viscoadh.count_subscribers("elastic/force") > 0,
+        TIMEOUT,
+    ), "namespaced command topic or remapped wrench topic did not match"
+    pub.publish(_command(probe.get_clock().now().nanoseconds + 10**9, depth=1e-6))
+    assert spin_until(ros_executor, lambda: bool(states) and bool(wrenches), TIMEOUT), "no state/wrench"
+    assert wrenches[-1].wrench.force.z == pytest.approx(states[-1].force, rel=1e-12)
+    expected = _reference("elastic").step(0.0, depth=1e-6)
+    np.testing.assert_allclose(states[-1].force, expected.force, rtol=1e-9, err_msg="namespaced contact")
+    assert pull_off.wait_for_service(timeout_sec=TIMEOUT), "namespaced service missing"
+    assert probe.count_publishers("/left_hand/elastic/wrench") == 0, "remap did not rename the wrench"
