@@ -149,3 +149,15 @@ def test_demo_shows_the_papers_effect(demo):
     lost = _number(report, "energy lost in cycle")
     f_c, _, d_c = reference.scales
     assert math.isfinite(lost) and lost > 0.01 * f_c * d_c, f"the cycle must lose energy ({lost} J)"
+
+
+def test_node_in_process_runs_at_the_nodes_gil_switch_interval() -> None:
+    """In-process, the node's live thread shares the GIL with the executor and the caller:
+    node_in_process runs at the interval `viscoadh node` uses and restores the caller's."""
+    from viscoadh_ros.demo import node_in_process
+    from viscoadh_ros.ros.node import GIL_SWITCH_INTERVAL_S
+
+    before = sys.getswitchinterval()
+    with node_in_process(SceneConfig.from_yaml(default_scene_path())):
+        assert sys.getswitchinterval() == pytest.approx(GIL_SWITCH_INTERVAL_S)
+    assert sys.getswitchinterval() == before

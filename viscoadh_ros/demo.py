@@ -21,6 +21,7 @@ from __future__ import annotations
 import contextlib
 import math
 import os
+import sys
 import threading
 import time as wallclock
 from collections.abc import Iterator
@@ -45,7 +46,7 @@ from viscoadh_ros.core.rheology import CreepElement
 from viscoadh_ros.core.simulator import Phase
 from viscoadh_ros.plotting import Curve, JkrReference, plot_loops
 from viscoadh_ros.ros import conversions
-from viscoadh_ros.ros.node import ViscoadhNode
+from viscoadh_ros.ros.node import GIL_SWITCH_INTERVAL_S, ViscoadhNode
 
 _DISCOVERY_RANGE = "ROS_AUTOMATIC_DISCOVERY_RANGE"
 #: The simulated clock starts here, s: a zero stamp would mean "now" to the node.
@@ -415,6 +416,12 @@ def node_in_process(
     private = {_DISCOVERY_RANGE: "OFF", "ROS_LOCALHOST_ONLY": None}
     previous = {name: os.environ.get(name) for name in private}
     _set_environment(private)
+    # The node's live thread, the executor and the caller's threads hand the GIL to each other
+    # several times per command; at Python's default 5 ms switch interval a thread busy in
+    # Python (an executor rebuilding its wait set) made each command take ~0.1 s. The same
+    # interval `viscoadh node` runs with, for as long as the node runs here.
+    previous_switch = sys.getswitchinterval()
+    sys.setswitchinterval(GIL_SWITCH_INTERVAL_S)
     context = rclpy.context.Context()
     try:
         rclpy.init(context=context, args=[])
@@ -446,6 +453,7 @@ def node_in_process(
     finally:
         rclpy.try_shutdown(context=context)
         _set_environment(previous)
+        sys.setswitchinterval(previous_switch)
 
 
 def _set_environment(values: dict[str, str | None]) -> None:
@@ -457,9 +465,7 @@ def _set_environment(values: dict[str, str | None]) -> None:
             os.environ[name] = value
 
 
-def run_demo(
-    *, scene_path: Path | None = None, out_dir: Path, contact_id: str | None = None
-) -> str:
+def run_demo(*, scene_path: Path | None = None, out_dir: Path, contact_id: str | None = None) -> str:
     """The main job: drive one cycle through the node, log it, plot it; return the summary text.
 
     scene_path: scene YAML (None: the built-in scene). out_dir: created if missing; gets
@@ -475,9 +481,10 @@ def run_demo(
     log_path = (out_dir / "demo.mcap").resolve()
     figure_path = (out_dir / "demo.png").resolve()
     log_path.unlink(missing_ok=True)
-    with node_in_process(
-        scene, use_sim_time=True, **{"log.enabled": True, "log.path": str(log_path)}
-    ) as (context, executor):
+    with node_in_process(scene, use_sim_time=True, **{"log.enabled": True, "log.path": str(log_path)}) as (
+        context,
+        executor,
+    ):
         client = Node("viscoadh_demo_driver", context=context)
         executor.add_node(client)
         driver = _Driver(client, contact.id, timeout=_TIMEOUT_S)
