@@ -27,20 +27,24 @@ def test_model_codes_cover_both_model_paths() -> None:
     }
 
 
+#: A detaching, tensile, unstable step: every field non-default and signed where it can be.
+OUTPUT = StepOutput(
+    time=1.5,
+    depth=-2e-6,
+    force=-3e-3,
+    contact_radius=4e-5,
+    phase=Phase.DETACHING,
+    edge_speed=-1e-4,
+    effective_work_of_adhesion=0.3,
+    energy_input=1e-9,
+    energy_dissipated=2e-10,
+    scale_separation_ok=False,
+    unstable=True,
+)
+
+
 def test_step_output_fields_are_all_carried_with_their_sign() -> None:
-    output = StepOutput(
-        time=1.5,
-        depth=-2e-6,
-        force=-3e-3,
-        contact_radius=4e-5,
-        phase=Phase.DETACHING,
-        edge_speed=-1e-4,
-        effective_work_of_adhesion=0.3,
-        energy_input=1e-9,
-        energy_dissipated=2e-10,
-        scale_separation_ok=False,
-        unstable=True,
-    )
+    output = OUTPUT
     state = conversions.contact_state(
         output,
         stamp_ns=3_000_000_007,
@@ -83,19 +87,7 @@ def test_command_selects_the_control_of_its_mode() -> None:
 def test_live_payloads_read_back_as_the_messages(frame_id: str) -> None:
     """The node publishes and logs these bytes: they must deserialise to exactly the messages
     contact_state/wrench build, whatever the frame id's length does to the CDR alignment."""
-    output = StepOutput(
-        time=1.5,
-        depth=-2e-6,
-        force=-3e-3,
-        contact_radius=4e-5,
-        phase=Phase.DETACHING,
-        edge_speed=-1e-4,
-        effective_work_of_adhesion=0.3,
-        energy_input=1e-9,
-        energy_dissipated=2e-10,
-        scale_separation_ok=False,
-        unstable=True,
-    )
+    output = OUTPUT
     stamp_ns = 1_795_352_880_799_998_059
     common = {"model": "closed_form", "commands_received": 70_000, "commands_rejected": 3}
     payloads = conversions.LivePayloads(frame_id)
