@@ -18,6 +18,11 @@ setup(
     ],
     package_data={PACKAGE: ["py.typed"]},
     install_requires=["setuptools"],
+    # Optional: `batch` (viscoadh fit/replay over many bags on Dask), `gripper` (MuJoCo scene).
+    extras_require={
+        "batch": ["dask>=2024.1", "distributed>=2024.1"],
+        "gripper": ["mujoco>=3.1"],
+    },
     zip_safe=True,
     maintainer="viscoadh_ros maintainers",
     maintainer_email="viscoadh-maintainers@contact-mechanics.org",
