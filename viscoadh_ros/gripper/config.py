@@ -126,7 +126,9 @@ class Cell:
         parameters = SceneConfig(contacts=(self.pad,)).to_parameters()
         prefix = f"{self.pad.id}."
         per_pad = {k[len(prefix) :]: v for k, v in parameters.items() if k.startswith(prefix)}
-        flat: dict[str, Any] = {k: v for k, v in parameters.items() if k != "contacts" and not k.startswith(prefix)}
+        flat: dict[str, Any] = {
+            k: v for k, v in parameters.items() if k != "contacts" and not k.startswith(prefix)
+        }
         ids = pad_ids(self.gripper.pad_count)
         flat["contacts"] = list(ids)
         for pad_id in ids:

@@ -139,7 +139,9 @@ def run_cycle(
     )
     dt_ns = round(cell.gripper.timestep * 1e9)
     m, d = world.model, world.data
-    rows: dict[str, list] = {k: [] for k in ("time", "arm", "ref", "rise", "latch", "depth", "force", "radius", "seg")}
+    rows: dict[str, list] = {
+        k: [] for k in ("time", "arm", "ref", "rise", "latch", "depth", "force", "radius", "seg")
+    }
     step = 0
     stop_at: int | None = None
     while True:
@@ -161,7 +163,12 @@ def run_cycle(
         rows["force"].append(states.force.copy())
         rows["radius"].append(states.contact_radius.copy())
         rows["seg"].append(program.segment(t))
-        if stop_after_release and stop_at is None and t >= program.starts["lift"] and not states.contact_radius.any():
+        if (
+            stop_after_release
+            and stop_at is None
+            and t >= program.starts["lift"]
+            and not states.contact_radius.any()
+        ):
             stop_at = step + 20
         mujoco.mj_step2(m, d)
         step += 1

@@ -61,7 +61,9 @@ class Motion:
         return self
 
 
-def _trapezoid(h0: float, h1: float, speed: float, acceleration: float) -> tuple[float, Callable[[float], float]]:
+def _trapezoid(
+    h0: float, h1: float, speed: float, acceleration: float
+) -> tuple[float, Callable[[float], float]]:
     """(duration s, height(t)) of a rest-to-rest move from h0 to h1 (m) with a trapezoidal
     velocity profile (triangular when too short to reach ``speed``)."""
     distance = abs(h1 - h0)

@@ -23,7 +23,7 @@ from numpy.typing import NDArray
 
 from viscoadh_ros.core._kernels import warm_up
 from viscoadh_ros.core.config import ContactConfig
-from viscoadh_ros.core.history import PullOffPrediction, predict_pull_off
+from viscoadh_ros.core.history import predict_pull_off
 from viscoadh_ros.core.simulator import ContactSimulator
 
 
@@ -50,9 +50,9 @@ class PadBank(Protocol):
     def step(self, time: float, depths: NDArray[np.float64]) -> PadStates:
         """Advance every pad to ``time`` (s) at ``depths[i]`` (m); their states."""
 
-    def predict_pull_off(self, retract_speed: float) -> list[PullOffPrediction]:
-        """`core.history.predict_pull_off` for every pad at ``retract_speed`` (m/s), from the
-        live states, which stay untouched."""
+    def predict_pull_off(self, retract_speed: float) -> NDArray[np.float64]:
+        """Pull-off force of every pad (N, < 0 adhesive; `core.history.predict_pull_off`)
+        if the arm retracted now at ``retract_speed`` (m/s); the live states stay untouched."""
 
     def close(self) -> None:
         """Release what the bank holds (threads, the node)."""
@@ -76,8 +76,8 @@ class LibraryPads:
             states.phase[i] = output.phase
         return states
 
-    def predict_pull_off(self, retract_speed: float) -> list[PullOffPrediction]:
-        return [predict_pull_off(simulator, retract_speed) for simulator in self.simulators]
+    def predict_pull_off(self, retract_speed: float) -> NDArray[np.float64]:
+        return np.array([predict_pull_off(s, retract_speed).pull_off_force for s in self.simulators])
 
     def close(self) -> None:
         """Nothing to release."""
