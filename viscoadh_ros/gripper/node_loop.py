@@ -132,7 +132,7 @@ class NodePads:
         for i, client in enumerate(self._predict):
             done = threading.Event()
             future = client.call_async(PredictPullOff.Request(retract_speed=float(retract_speed)))
-            future.add_done_callback(lambda _: done.set())
+            future.add_done_callback(lambda _, done=done: done.set())
             if not done.wait(ANSWER_TIMEOUT_S) or future.result() is None:
                 raise RuntimeError(f"{self.ids[i]}/predict_pull_off did not answer")
             answer = future.result()
