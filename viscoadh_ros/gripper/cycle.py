@@ -33,7 +33,7 @@ from viscoadh_ros.core.rheology import CreepElement
 from .config import Cell
 from .motion import ArmProgram, Motion
 from .pads import PadBank, step_time
-from .scene import CellModel
+from .scene import LATCH_CLEARANCE, CellModel
 
 #: The part counts as lifted (or pulled out of the fixture) above this rise, m.
 LIFT_THRESHOLD = 0.5e-3
@@ -130,7 +130,7 @@ def run_cycle(
     check_stability(cell, motion)
     if bank.count != cell.gripper.pad_count:
         raise InputError(f"the bank has {bank.count} pads, the cell {cell.gripper.pad_count}")
-    world = CellModel(cell)
+    world = CellModel(cell, latch_open_height=motion.lift_height + LATCH_CLEARANCE)
     program = ArmProgram(
         motion,
         start_height=cell.gripper.arm.start_height,

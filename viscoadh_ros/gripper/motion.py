@@ -7,8 +7,8 @@ follows the reference with its own stiffness, so the depth reached is slightly l
 Segments, in order: ``approach`` (constant speed from the start height to ``-press_depth``),
 ``hold``, ``lift`` (trapezoidal velocity: ``lift_acceleration`` up to ``lift_speed``, and down
 again, to ``lift_height``), ``carry`` (held up); with ``place``: ``lower`` (trapezoidal, back to
-``-place_depth``), ``latch`` (the fixture's latch closes over ``latch_time``, then settles as
-long again), ``retract`` (constant ``retract_speed`` up to ``lift_height``), ``dwell``.
+``-place_depth``), ``latch`` (the fixture's latch closes over ``latch_time``, then settles for
+``LATCH_SETTLE_TIME``), ``retract`` (constant ``retract_speed`` up to ``RETRACT_TRAVEL``), ``dwell``.
 """
 
 from __future__ import annotations
@@ -23,6 +23,10 @@ from viscoadh_ros.core.errors import InputError, require_positive
 SEGMENTS = ("approach", "hold", "lift", "carry", "lower", "latch", "retract", "dwell")
 #: How long the arm dwells after the retraction, s.
 DWELL_TIME = 0.05
+#: How long the closed latch settles on the part before the retraction, s.
+LATCH_SETTLE_TIME = 0.2
+#: How far the retraction of a place goes up, m (a part pulled out rises with it).
+RETRACT_TRAVEL = 2.0e-3
 
 
 @dataclass(frozen=True)
@@ -119,7 +123,7 @@ class ArmProgram:
             lower, lower_height = _trapezoid(m.lift_height, -m.place_depth, m.lift_speed, m.lift_acceleration)
             self._segments += [
                 ("lower", lower, lower_height),
-                ("latch", 2.0 * latch_time, lambda t: -m.place_depth),
+                ("latch", latch_time + LATCH_SETTLE_TIME, lambda t: -m.place_depth),
                 ("retract", math.inf, self._retract_height),
             ]
         self.latch_time = latch_time
@@ -144,7 +148,7 @@ class ArmProgram:
             return self.starts[name] + duration
         if self.retract_speed is None:
             return math.inf
-        distance = self.motion.lift_height + self.motion.place_depth
+        distance = RETRACT_TRAVEL + self.motion.place_depth
         return self.starts["retract"] + distance / self.retract_speed + DWELL_TIME
 
     def segment(self, t: float) -> str:
@@ -162,7 +166,7 @@ class ArmProgram:
             if seg_name == name:
                 if name == "retract":
                     local = t - self.starts[name]
-                    return min(height(local), self.motion.lift_height)
+                    return min(height(local), RETRACT_TRAVEL)
                 return height(t - self.starts[name])
         raise AssertionError(name)
 

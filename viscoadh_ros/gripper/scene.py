@@ -18,8 +18,9 @@ Who touches whom:
 - arm body: contype 0, conaffinity 0 (it touches nothing).
 
 Each physics step (`pad_geometry` after ``mj_step1``): the indentation of each pad is minus
-MuJoCo's signed distance between the pad sphere and the part box (``mj_geomDistance``), the
-normal is from the nearest point of the part to the pad's centre. `apply_pad_forces` puts
+MuJoCo's signed distance between the pad sphere and the part box (``mj_geomDistance``); the
+force acts along the pad's axis (vertical: a top-down gripper) under the pad's centre, at the
+height of the part's nearest point. `apply_pad_forces` puts
 ``+F n`` on the arm and ``-F n`` on the part at that point (``mj_applyFT`` into
 ``qfrc_applied``, cleared first), then ``mj_step2`` integrates.
 """
@@ -39,17 +40,18 @@ from .config import LATCH_WIDTH, Cell
 DISTANCE_CAP = 0.01
 #: Latch bar thickness, m, and mass, kg.
 LATCH_THICKNESS = 0.002
-LATCH_MASS = 0.005
+LATCH_MASS = 0.001
 #: Table and latch contact time constant, s (MuJoCo solref; at least two physics steps).
 CONTACT_TIME_CONSTANT = 2.0e-3
-#: Height of the open latch above the part's resting top, m (clear of any lift in the scenarios).
-LATCH_OPEN_HEIGHT = 0.05
+#: The open latch waits this far above the highest the part's top is lifted to, m.
+LATCH_CLEARANCE = 0.003
 
 
 @dataclass(frozen=True)
 class PadGeometry:
     """Per pad, this step: depth (m, > 0 presses in), unit normal from the part to the pad
-    (shape (n, 3)) and the contact point on the part (shape (n, 3), world frame, m)."""
+    (the pad's axis, +z; shape (n, 3)) and the point the force acts at (under the pad's
+    centre, on the part's nearest point's height; shape (n, 3), world frame, m)."""
 
     depth: NDArray[np.float64]
     normal: NDArray[np.float64]
@@ -126,13 +128,15 @@ def model_xml(cell: Cell) -> tuple[str, float]:
 class CellModel:
     """The MuJoCo model and data of a cell, and the pad geometry/force exchange.
 
+    latch_open_height: m of the open latch above the part's resting top (clear of the lift).
     ``arm_height``, ``part_rise``, ``latch_height``: m, the arm's pad-tip plane above the part's
     resting top, the part's lift above its resting height, the latch bars' underside above the
     part's resting top.
     """
 
-    def __init__(self, cell: Cell) -> None:
+    def __init__(self, cell: Cell, *, latch_open_height: float) -> None:
         self.cell = cell
+        self.latch_open_height = latch_open_height
         xml, self.latch_closed_target = model_xml(cell)
         self.model = mujoco.MjModel.from_xml_string(xml)
         self.data = mujoco.MjData(self.model)
@@ -151,7 +155,7 @@ class CellModel:
         self._fromto = np.zeros(6)
         self._zero = np.zeros(3)
         self._depth = np.zeros(count)
-        self._normal = np.zeros((count, 3))
+        self._normal = np.tile(np.array([0.0, 0.0, 1.0]), (count, 1))
         self._point = np.zeros((count, 3))
         self.reset()
 
@@ -159,7 +163,7 @@ class CellModel:
         """Back to t = 0: arm at its start height, latch open, part at rest."""
         mujoco.mj_resetData(self.model, self.data)
         self.data.qpos[self.arm_qpos] = self.cell.gripper.arm.start_height
-        self.data.qpos[self.latch_qpos] = LATCH_OPEN_HEIGHT
+        self.data.qpos[self.latch_qpos] = self.latch_open_height
         self.set_controls(self.cell.gripper.arm.start_height, latch_closed=False)
         mujoco.mj_forward(self.model, self.data)
 
@@ -168,7 +172,7 @@ class CellModel:
         or a fraction of the way (0..1, for a latch closing over `latch_time`)."""
         fraction = float(latch_closed)
         self.data.ctrl[self.arm_actuator] = arm_height
-        self.data.ctrl[self.latch_actuator] = (1.0 - fraction) * LATCH_OPEN_HEIGHT + fraction * (
+        self.data.ctrl[self.latch_actuator] = (1.0 - fraction) * self.latch_open_height + fraction * (
             self.latch_closed_target
         )
 
@@ -179,11 +183,11 @@ class CellModel:
         for i, geom in enumerate(self.pad_geoms):
             distance = mujoco.mj_geomDistance(m, d, geom, self.part_geom, DISTANCE_CAP, self._fromto)
             self._depth[i] = -distance
-            on_part = self._fromto[3:]
-            normal = d.geom_xpos[geom] - on_part
-            length = math.sqrt(normal @ normal)
-            self._normal[i] = normal / length if length > 0.0 else (0.0, 0.0, 1.0)
-            self._point[i] = on_part
+            # The force acts along the pad's axis (the arm's -z), through the pad's centre: the
+            # model is axisymmetric and frictionless, and a normal tilted with a tilting part
+            # would push it sideways with nothing (no friction) to hold it, a runaway.
+            self._point[i] = d.geom_xpos[geom]
+            self._point[i, 2] = self._fromto[5]
         return PadGeometry(self._depth, self._normal, self._point)
 
     def apply_pad_forces(self, geometry: PadGeometry, force: NDArray[np.float64]) -> None:
