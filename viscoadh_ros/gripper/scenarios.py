@@ -172,7 +172,7 @@ def scenario_controller(cell: Cell, bank: Bank) -> list[Run]:
 
 
 #: Part masses of the weights scenario, kg.
-WEIGHTS = (0.6e-3, 0.9e-3, 1.2e-3, 1.5e-3, 1.8e-3)
+WEIGHTS = (0.5e-3, 0.8e-3, 1.1e-3, 1.4e-3, 1.7e-3)
 
 
 def scenario_weights(cell: Cell, bank: Bank) -> list[Run]:
