@@ -44,6 +44,8 @@ SCENE: dict[str, Any] = {
     "visco.numerics.preset": "fast",
     # Keep the hold timer out of the way of command-driven tests.
     "publish_rate": 1.0,
+    # Commands are stamped ahead of the clock (see Client.t0), by up to 10 s in the threading test.
+    "command.max_future_s": 30.0,
 }
 TIMEOUT = 5.0
 T0_NS = 1_000_000_000_000  # /clock of the simulated-time test starts here, ns
@@ -333,9 +335,9 @@ def test_diagnostics_and_markers(ros_context: Any, ros_executor: Any, spin_until
     client.send(_command(0, depth=math.nan), expect_state=False)
     assert spin_until(ros_executor, lambda: arrays and any(m.type == Marker.SPHERE for m in marks), 3.0)
     status = {s.name: {kv.key: kv.value for kv in s.values} for s in arrays[-1].status}
-    assert set(status) == {"viscoadh: elastic", "viscoadh: visco"}
-    elastic = status["viscoadh: elastic"]
-    assert elastic["model"] == "closed_form" and status["viscoadh: visco"]["model"] == "time_stepped"
+    assert set(status) == {"/viscoadh: elastic", "/viscoadh: visco"}, "named after the node's full name"
+    elastic = status["/viscoadh: elastic"]
+    assert elastic["model"] == "closed_form" and status["/viscoadh: visco"]["model"] == "time_stepped"
     assert elastic["commands_received"] == "1" and elastic["commands_rejected"] == "1"
     disc = next(m for m in marks if m.type == Marker.CYLINDER and m.action == Marker.ADD)
     assert disc.scale.x > 0.0, "contact disc drawn with the contact diameter"

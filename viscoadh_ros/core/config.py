@@ -155,6 +155,8 @@ class NodeConfig:
     log_max_bytes [log.max_bytes]: rotate after this many bytes (0 = never).
     log_max_duration [log.max_duration]: rotate after this many seconds (0 = never).
     log_queue_size [log.queue_size]: bound of the writer queue, messages (> 0).
+    command_max_future_s [command.max_future_s]: how far ahead of the node clock a command's
+      ``header.stamp`` may be, s (>= 0); a command stamped further ahead is rejected.
     """
 
     publish_rate: float = 50.0
@@ -166,6 +168,7 @@ class NodeConfig:
     log_max_bytes: int = 0
     log_max_duration: float = 0.0
     log_queue_size: int = 10000
+    command_max_future_s: float = 1.0
 
 
 # --- schema: flat key -> (section dataclass field, kind) ------------------------------------
@@ -189,7 +192,7 @@ CONTACT_KEYS: dict[str, str] = {
 }
 #: node-level keys: "publish_rate" -> "float", "markers.enabled" -> "bool", ...
 NODE_KEYS: dict[str, str] = {
-    name.replace("markers_", "markers.").replace("log_", "log.", 1): kind
+    name.replace("markers_", "markers.").replace("log_", "log.", 1).replace("command_", "command.", 1): kind
     for name, kind in _kinds(NodeConfig).items()
 }
 _SHAPE_KEYS = {
@@ -362,6 +365,7 @@ def _build_node(given: dict[str, Any]) -> NodeConfig:
         ("log.max_bytes", node.log_max_bytes >= 0, ">= 0"),
         ("log.max_duration", node.log_max_duration >= 0.0, ">= 0"),
         ("log.queue_size", node.log_queue_size > 0, "> 0"),
+        ("command.max_future_s", node.command_max_future_s >= 0.0, ">= 0"),
     ]
     for key, ok, bound in checks:
         if not ok:

@@ -38,7 +38,7 @@ _RCLPY_PARAMETERS = frozenset({"use_sim_time", "start_type_description_service"}
 _RCLPY_PREFIXES = ("qos_overrides.",)
 
 #: Node-level parameters that the node applies at runtime without touching any contact.
-RUNTIME_NODE_PARAMETERS = frozenset({"publish_rate", "frame_id", "markers.enabled"})
+RUNTIME_NODE_PARAMETERS = frozenset({"publish_rate", "frame_id", "markers.enabled", "command.max_future_s"})
 
 _INF = math.inf
 
@@ -145,6 +145,12 @@ _NODE_SPECS: dict[str, _Spec] = {
         "out through the indenter."
     ),
     "markers.enabled": _Spec("Publish C/marker (contact disc and indenter) for RViz/Foxglove."),
+    "command.max_future_s": _Spec(
+        "How far ahead of the node clock a command's header.stamp may be, s; a command stamped "
+        "further ahead is rejected (it would move the contact's time).",
+        low=0.0,
+        high=_INF,
+    ),
     "log.enabled": _Spec("Record commands, states and wrenches to MCAP.", read_only=True),
     "log.path": _Spec("MCAP file or folder for the log.", read_only=True),
     "log.chunk_size": _Spec("MCAP chunk size, bytes.", low=1, high=2**31 - 1, read_only=True),
