@@ -389,6 +389,22 @@ _RosYamlLoader.add_implicit_resolver(
 )
 
 
+def read_yaml(path: str | Path, *, what: str = "scene file") -> Any:
+    """The YAML document in ``path``, read as ROS 2 reads params files; ConfigError (one line,
+    naming the file) when it cannot be read or parsed. A byte-order mark is accepted."""
+    file = Path(path)
+    try:
+        text = file.read_text(encoding="utf-8-sig")
+    except (OSError, UnicodeDecodeError) as error:
+        reason = error.strerror if isinstance(error, OSError) else str(error)
+        raise ConfigError(f"cannot read {what} {str(file)!r}: {reason}") from None
+    try:
+        return yaml.load(text, Loader=_RosYamlLoader)  # noqa: S506 - a SafeLoader subclass
+    except yaml.YAMLError as error:
+        detail = " ".join(str(error).split())
+        raise ConfigError(f"{what} {str(file)!r} is not valid YAML: {detail}") from None
+
+
 @dataclass(frozen=True, kw_only=True)
 class SceneConfig:
     """A validated scene: the contacts (in the order of ``contacts``) and the node settings."""
@@ -448,14 +464,7 @@ class SceneConfig:
     def from_yaml(cls, path: str | Path) -> SceneConfig:
         """From a ROS 2 parameters YAML file (or a bare/flat mapping in YAML)."""
         file = Path(path)
-        try:
-            text = file.read_text(encoding="utf-8")
-        except OSError as error:
-            raise ConfigError(f"cannot read scene file {str(file)!r}: {error.strerror}") from None
-        try:
-            data = yaml.load(text, Loader=_RosYamlLoader)  # noqa: S506 - a SafeLoader subclass
-        except yaml.YAMLError as error:
-            raise ConfigError(f"scene file {str(file)!r} is not valid YAML: {error}") from None
+        data = read_yaml(file)
         if not isinstance(data, Mapping):
             raise ConfigError(f"scene file {str(file)!r} must hold a mapping of parameters")
         return cls.from_dict(data)

@@ -265,7 +265,7 @@ class _Contact:
                 output = self.simulator.step(target, **control)
                 self.counters.steps.add(time.perf_counter() - started)
             except ValueError as error:
-                reason = f"command rejected: {error}"
+                reason = f"command rejected ({conversions.describe_command(msg)}): {error}"
                 self._reject_locked(reason, command=True)
                 self.event_locked(
                     ContactEvent.COMMAND_REJECTED, now_ns, reason=reason, index=index, stamp=msg.header.stamp
@@ -763,14 +763,29 @@ def main(args: list[str] | None = None) -> int:
     """
     # A command should not wait up to CPython's default 5 ms for a busy service thread.
     sys.setswitchinterval(GIL_SWITCH_INTERVAL_S)
-    rclpy.init(args=args)
+    try:
+        parameters.check_params_files(list(args or []))
+        rclpy.init(args=args)
+    except ConfigError as error:
+        print(f"viscoadh node: error: {error}", file=sys.stderr, flush=True)
+        return 2
+    except _rclpy.RCLError as error:
+        detail = " ".join(str(error).split())
+        print(f"viscoadh node: error: ROS arguments rejected: {detail}", file=sys.stderr, flush=True)
+        return 2
     node = None
     try:
         node = ViscoadhNode()
         executor = MultiThreadedExecutor()
         executor.add_node(node)
         while rclpy.ok() and node.live_error is None:
-            executor.spin_once(timeout_sec=0.5)
+            try:
+                executor.spin_once(timeout_sec=0.5)
+            except Exception:
+                # SIGINT/SIGTERM shut the context down between the check and the wait.
+                if rclpy.ok():
+                    raise
+                break
         if node.live_error is not None:
             print(f"viscoadh node: error: live path failed: {node.live_error!r}", file=sys.stderr, flush=True)
             return 1
@@ -781,6 +796,8 @@ def main(args: list[str] | None = None) -> int:
         pass
     finally:
         if node is not None:
+            logger = node.get_logger()
             node.destroy_node()
+            logger.info("finished")
         rclpy.try_shutdown()
     return 0

@@ -30,7 +30,8 @@ from rcl_interfaces.msg import (
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
-from viscoadh_ros.core.config import CONTACT_KEYS, NODE_KEYS, SceneConfig, load_default_scene
+from viscoadh_ros.core.config import CONTACT_KEYS, NODE_KEYS, SceneConfig, load_default_scene, read_yaml
+from viscoadh_ros.core.errors import ConfigError
 
 #: Parameters every rclpy node declares itself; they are not part of the scene.
 _RCLPY_PARAMETERS = frozenset({"use_sim_time", "start_type_description_service"})
@@ -297,3 +298,17 @@ def classify_change(name: str, contact_ids: tuple[str, ...]) -> str | None:
     if name in _NODE_SPECS or name.startswith("log."):
         return ""
     return None
+
+
+def check_params_files(args: list[str]) -> None:
+    """Read every ``--params-file FILE`` of the ROS arguments ``args`` before rclpy does, so a
+    missing or unparsable file is one ConfigError line naming it (rcl's own error is a
+    traceback). The scene inside is validated later, by the node, like any parameters."""
+    for flag, value in zip(args, args[1:], strict=False):
+        if flag == "--params-file":
+            data = read_yaml(value, what="params file")
+            if not isinstance(data, Mapping):
+                raise ConfigError(
+                    f"params file {value!r} must hold a mapping ({{node name or /**: "
+                    f"{{ros__parameters: ...}}}}), got {type(data).__name__}"
+                )
