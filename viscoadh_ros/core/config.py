@@ -202,6 +202,27 @@ _SHAPE_KEYS = {
     "power_law": ("coefficient", "exponent"),
     "table": ("table_radius", "table_height"),
 }
+#: Physical range of every indenter, material and adhesion number, relative key -> (low, high,
+#: unit), both ends included (lists: every element). Outside it the model would compute with
+#: numbers no body has (G0 = 1e-300 Pa gives a contact radius of 1e98 m) or overflow (1e308 Pa);
+#: docs/configuration.md lists the same ranges.
+PHYSICAL_RANGES: dict[str, tuple[float, float, str]] = {
+    "indenter.radius": (1e-9, 1e3, "m"),
+    "indenter.half_angle": (1e-3, math.pi / 2 - 1e-3, "rad"),
+    "indenter.coefficient": (1e-30, 1e30, "m^(1-n)"),
+    "indenter.exponent": (0.1, 10.0, ""),
+    "indenter.table_radius": (0.0, 1e3, "m"),
+    "indenter.table_height": (0.0, 1e3, "m"),
+    "material.glass_shear_modulus": (1.0, 1e12, "Pa"),
+    "material.kelvin_shear_moduli": (1.0, 1e12, "Pa"),
+    "material.kelvin_viscosities": (1e-6, 1e15, "Pa s"),
+    "material.poisson_ratio": (0.0, 0.5, ""),
+    "material.prony_long_term_modulus": (1.0, 1e12, "Pa"),
+    "material.prony_moduli": (1.0, 1e12, "Pa"),
+    "material.prony_times": (1e-9, 1e9, "s"),
+    "adhesion.work_of_adhesion": (0.0, 1e3, "J/m^2"),
+    "adhesion.interaction_range": (1e-12, 1e-3, "m"),
+}
 _KELVIN_KEYS = ("glass_shear_modulus", "kelvin_shear_moduli", "kelvin_viscosities")
 _PRONY_KEYS = ("prony_long_term_modulus", "prony_moduli", "prony_times")
 # A ROS name token; ids become topic namespaces. "__" is reserved by ROS.
@@ -281,8 +302,26 @@ def _unknown_key(key: str, valid: list[str]) -> ConfigError:
     return ConfigError(f"unknown parameter {key!r}{hint}")
 
 
+def _check_range(key: str, value: Any) -> None:
+    """ConfigError naming ``key`` and its :data:`PHYSICAL_RANGES` entry if ``value`` (or an
+    element of it) lies outside."""
+    low, high, unit = PHYSICAL_RANGES[key.split(".", 1)[1]]
+    values = value if isinstance(value, tuple) else (value,)
+    for index, number in enumerate(values):
+        if not low <= number <= high:
+            name = f"{key}[{index}]" if isinstance(value, tuple) else key
+            raise ConfigError(
+                f"{name} must be in [{low:.6g}, {high:.6g}]{' ' + unit if unit else ''} (got {number:.6g})"
+            )
+
+
 def _build_contact(contact_id: str, given: dict[str, Any]) -> ContactConfig:
     """A validated ContactConfig from its coerced relative keys (``"indenter.radius"``...)."""
+    used = {f"indenter.{name}" for name in _SHAPE_KEYS.get(given.get("indenter.shape"), ())}
+    for key, value in given.items():
+        # Keys of other indenter shapes are ignored (see the module docstring), so not checked.
+        if key in PHYSICAL_RANGES and (key in used or not key.startswith("indenter.")):
+            _check_range(f"{contact_id}.{key}", value)
 
     def section(name: str) -> dict[str, Any]:
         return {k.split(".", 1)[1]: v for k, v in given.items() if k.startswith(f"{name}.")}
