@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 import yaml
 from diagnostic_msgs.msg import DiagnosticArray
+from mcap.reader import make_reader
 from rclpy.parameter import Parameter
 from rclpy.qos import qos_profile_sensor_data
 from std_srvs.srv import Trigger
@@ -219,6 +220,12 @@ def test_events_log_every_rejection_reset_and_parameter_change_in_order(
 
     ros_executor.remove_node(node)
     node.destroy_node()
+    with open(log, "rb") as stream:
+        summary = make_reader(stream).get_summary()
+    schema = next(s for s in summary.schemas.values() if s.name == "viscoadh_msgs/msg/ContactEvent")
+    assert "MSG: builtin_interfaces/Time" in schema.data.decode(), "the schema carries its dependencies"
+    channel = next(c for c in summary.channels.values() if c.topic == "/elastic/events")
+    assert yaml.safe_load(channel.metadata["offered_qos_profiles"])[0]["durability"] == "transient_local"
     bag = Bag(log)
     sequence = [
         (m.topic, getattr(m.msg, "kind", None))

@@ -53,7 +53,7 @@ from viscoadh_ros.core.errors import ConfigError, InputError
 from viscoadh_ros.core.history import predict_pull_off, simulate_history
 from viscoadh_ros.core.simulator import ContactSimulator, StepOutput
 from viscoadh_ros.io import cdr
-from viscoadh_ros.io.mcap_log import McapRecorder, plain
+from viscoadh_ros.io.mcap_log import McapRecorder, TopicQos, plain
 from viscoadh_ros.ros import conversions, diagnostics, markers, parameters
 
 NODE_NAME = "viscoadh"
@@ -592,7 +592,10 @@ class ViscoadhNode(Node):
         self.max_future_ns = round(self.scene.node.command_max_future_s * _NS_PER_S)
         # MCAP logging; None while logging is off. Opened before the endpoints exist, so the
         # log holds every command received and every state and wrench published.
-        self._recorder: Recorder | None = _open_recorder(self.scene)
+        events_qos = TopicQos(depth=EVENTS_QOS.depth, durability="transient_local")
+        self._recorder: Recorder | None = _open_recorder(
+            self.scene, {self.resolve_topic_name(f"{c.id}/events"): events_qos for c in self.scene.contacts}
+        )
         # Compile/load every numba kernel before the first command can arrive (~0.2 s).
         warm_up()
         warmed = time.perf_counter()
@@ -718,8 +721,9 @@ class ViscoadhNode(Node):
         super().destroy_node()
 
 
-def _open_recorder(scene: SceneConfig) -> McapRecorder | None:
-    """The MCAP recorder the scene's ``log.*`` parameters ask for (None when logging is off).
+def _open_recorder(scene: SceneConfig, qos: dict[str, TopicQos]) -> McapRecorder | None:
+    """The MCAP recorder the scene's ``log.*`` parameters ask for (None when logging is off);
+    ``qos``: offered QoS of the topics that differ from the default (``C/events``).
 
     The whole scene goes into the file's metadata record, so the log alone replays the run.
     """
@@ -733,6 +737,7 @@ def _open_recorder(scene: SceneConfig) -> McapRecorder | None:
         max_bytes=node.log_max_bytes,
         max_duration=node.log_max_duration,
         queue_size=node.log_queue_size,
+        qos=qos,
     )
 
 
