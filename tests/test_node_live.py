@@ -214,6 +214,7 @@ def test_simulate_history_matches_the_core_and_leaves_the_live_state(client: Cli
     [
         (dict(mode=0, time=[0.0, 1.0], depth=[1e-6]), "mismatched lengths"),
         (dict(mode=0, time=[0.0, 1.0, 0.5], depth=[1e-6, 2e-6, 3e-6]), "non-monotonic time"),
+        (dict(mode=0, time=[0.0, 1.0, 1.0], depth=[1e-6, 2e-6, 3e-6]), "repeated time"),
         (dict(mode=0, time=[0.0, math.nan], depth=[1e-6, 2e-6]), "NaN time"),
         (dict(mode=0, time=[0.0, 1.0], depth=[1e-6, math.inf]), "inf depth"),
         (dict(mode=4, time=[0.0, 1.0], depth=[1e-6, 2e-6]), "unknown mode"),
@@ -226,10 +227,16 @@ def test_bad_history_request_is_refused(
     response = client.call(client.history, SimulateHistory.Request(**request_fields))
     assert not response.success, reason
     assert response.message, f"{reason}: the refusal must say why"
+    assert "np." not in response.message and " 1 samples" not in response.message, response.message
     assert node.contacts["elastic"].counters.requests_rejected == 1, reason
 
 
-@pytest.mark.parametrize("speed", [0.0, -1e-3, math.nan, math.inf])
+def test_simulate_history_of_one_sample(client: Client) -> None:
+    response = client.call(client.history, SimulateHistory.Request(mode=0, time=[0.0], depth=[1e-6]))
+    assert response.success and response.message == "1 sample", response.message
+
+
+@pytest.mark.parametrize("speed", [0.0, -1e-3, math.nan, math.inf, 5e-324, 1e300])
 def test_predict_pull_off_refuses_a_bad_speed(client: Client, speed: float) -> None:
     client.send(_command(client.t0, depth=5e-6))
     response = client.call(client.pull_off, PredictPullOff.Request(retract_speed=speed))

@@ -211,5 +211,6 @@ def history_response(result: HistoryResult, response: SimulateHistory.Response) 
     response.contact_radius = _sequence("d", result.contact_radius)
     response.phase = _sequence("B", result.phase)
     response.success = True
-    response.message = f"{len(response.force)} samples"
+    samples = len(response.force)
+    response.message = f"{samples} sample{'' if samples == 1 else 's'}"
     return response
