@@ -42,12 +42,15 @@ def _node(context: Any, executor: Any, scene: dict[str, Any] = FAULT_SCENE, **kw
 class EventClient(Client):
     """A client that also listens to the contact's events (as a late joiner would)."""
 
-    def __init__(self, *args: Any, contact: str = "elastic", **kwargs: Any) -> None:
+    def __init__(
+        self, *args: Any, contact: str = "elastic", ahead_ns: int = 300_000_000, **kwargs: Any
+    ) -> None:
         super().__init__(*args, contact=contact, **kwargs)
         self.events: list[ContactEvent] = []
         self.node.create_subscription(ContactEvent, f"{contact}/events", self.events.append, 50)
-        # Stamps a little ahead of the clock, within the default tolerance of 1 s.
-        self.t0 = self.node.get_clock().now().nanoseconds + 300_000_000
+        # Stamps ahead of the clock (by default within the default tolerance of 1 s): the hold
+        # timer advances a contact only up to now.
+        self.t0 = self.node.get_clock().now().nanoseconds + ahead_ns
 
     def rejected(self, index: int) -> ContactEvent:
         """Wait for the COMMAND_REJECTED event of command ``index``."""
@@ -104,9 +107,10 @@ def test_a_malformed_stamp_is_rejected(
 def test_a_refused_huge_depth_leaves_the_contact_as_its_twin(
     ros_context: Any, ros_executor: Any, spin_until: Any
 ) -> None:
-    """Time-stepped contact (a standard solid): 1e10 m cannot be represented by its domain."""
-    _node(ros_context, ros_executor)
-    client = EventClient(ros_context, ros_executor, spin_until, contact="visco")
+    """Time-stepped contact (a standard solid): 1e10 m cannot be represented by its domain.
+    Stamps 10 s ahead, so the hold timer never relaxes it between the commands."""
+    _node(ros_context, ros_executor, {**FAULT_SCENE, "command.max_future_s": 30.0})
+    client = EventClient(ros_context, ros_executor, spin_until, contact="visco", ahead_ns=10 * 10**9)
     twin = _twin("visco")
     depths = [5e-6, 1.2e-5, 2e-5]
     for k, depth in enumerate(depths):
