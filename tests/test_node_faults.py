@@ -89,6 +89,17 @@ def test_a_command_stamped_far_ahead_is_rejected_and_does_not_lock_the_contact(
     assert (after.commands_received, after.commands_rejected) == (2, 1)
 
 
+def test_the_future_tolerance_changes_at_runtime(
+    ros_context: Any, ros_executor: Any, spin_until: Any
+) -> None:
+    node = _node(ros_context, ros_executor)
+    client = EventClient(ros_context, ros_executor, spin_until)
+    ahead = node.now_ns() + 3 * 10**9
+    assert client.send(_command(ahead, depth=1e-6), expect_state=False) is None, "3 s ahead > 1 s"
+    assert node.set_parameters([Parameter("command.max_future_s", value=10.0)])[0].successful
+    assert client.send(_command(ahead, depth=1e-6)) is not None, "3 s ahead <= 10 s"
+
+
 @pytest.mark.parametrize(
     "sec, nanosec", [(-(2**31), 0), (-1, 999_999_999), (5, 1_000_000_000), (5, 2**32 - 1)]
 )

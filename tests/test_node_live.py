@@ -17,7 +17,7 @@ from rclpy.exceptions import ParameterNotDeclaredException
 from rclpy.parameter import Parameter
 from rosgraph_msgs.msg import Clock
 from std_srvs.srv import Trigger
-from viscoadh_msgs.msg import ContactState, IndentationCommand
+from viscoadh_msgs.msg import ContactEvent, ContactState, IndentationCommand
 from viscoadh_msgs.srv import PredictPullOff, SimulateHistory
 from visualization_msgs.msg import Marker
 
@@ -306,6 +306,8 @@ def test_hold_timer_relaxes_and_clock_jump_back_resets(
     ros_executor.add_node(node)
     client = Client(ros_context, ros_executor, spin_until, contact="visco")
     clock = client.node.create_publisher(Clock, "/clock", 10)
+    events: list[ContactEvent] = []
+    client.node.create_subscription(ContactEvent, "visco/events", events.append, 10)
 
     def tick(ns: int) -> None:
         clock.publish(Clock(clock=ns_to_stamp(ns)))
@@ -324,6 +326,8 @@ def test_hold_timer_relaxes_and_clock_jump_back_resets(
     assert held.force < pressed.force, "the force relaxes while holding"
     tick(T0_NS + 10**9)  # the bag looped
     assert spin_until(ros_executor, lambda: node.contacts["visco"].last_command_ns is None, TIMEOUT)
+    assert spin_until(ros_executor, lambda: bool(events), TIMEOUT), "the reset is an event"
+    assert events[-1].kind == ContactEvent.RESET and "clock jumped back" in events[-1].reason
     state = client.send(_command(T0_NS + 10**9, depth=-1e-6))
     assert state is not None and state.phase == ContactState.NO_CONTACT, "reset after the jump"
 
