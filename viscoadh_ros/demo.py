@@ -409,8 +409,10 @@ def node_in_process(
     ``parameters`` are extra node parameters by their flat names (``use_sim_time=True``,
     ``**{"log.enabled": True}``). Yields (context, executor): create client nodes with
     ``Node(name, context=context)`` and ``executor.add_node(node)``. The ROS traffic stays in
-    this process (discovery range OFF while the context is created). On exit
-    the node is destroyed (which finishes its MCAP log) and the context shut down.
+    this process (discovery range OFF while the context is created). On exit the spinner
+    stops, then every node on the executor is destroyed (the ``viscoadh`` node's MCAP log is
+    finished) and the context shut down: callers leave their nodes on the executor rather than
+    destroying them while it spins.
     """
     # rcl reads these at init; ROS_LOCALHOST_ONLY (deprecated) would override the range.
     private = {_DISCOVERY_RANGE: "OFF", "ROS_LOCALHOST_ONLY": None}
@@ -446,9 +448,14 @@ def node_in_process(
             # Stop spinning before anything is torn down: rclpy's Executor.shutdown does not
             # wait for a spinning thread and destroys the guard condition that thread waits on
             # (an AttributeError inside the executor), so the spinner must be gone first.
+            # The same holds for the caller's nodes: one destroyed while the spinner may still be
+            # inside `spin_once` with its entities in the wait set raises InvalidHandle in the
+            # spinner. So every node still on the executor is destroyed here, after it stopped.
             stop.set()
             spinner.join(timeout=5.0)
-            node.destroy_node()
+            for added in executor.get_nodes():
+                executor.remove_node(added)
+                added.destroy_node()
             executor.shutdown(timeout_sec=5.0)
     finally:
         rclpy.try_shutdown(context=context)

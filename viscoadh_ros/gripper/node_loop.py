@@ -57,10 +57,10 @@ class NodePads:
             context, executor = self._stack.enter_context(
                 node_in_process(cell.pad_scene(), use_sim_time=True, publish_rate=NODE_PUBLISH_RATE)
             )
+            # Destroyed by node_in_process once its spinner has stopped (destroying it here,
+            # while the spinner may be waiting on its entities, raised InvalidHandle there).
             self._node = Node("viscoadh_gripper_cell", context=context)
-            self._stack.callback(self._node.destroy_node)
             executor.add_node(self._node)
-            self._stack.callback(executor.remove_node, self._node)
             self._setup()
         except BaseException:
             self._stack.close()
