@@ -13,6 +13,7 @@ from pathlib import Path
 
 import yaml
 
+from viscoadh_ros.cli._paths import refuse_overwrite
 from viscoadh_ros.cli.replay import add_input_arguments, open_experiment
 from viscoadh_ros.core.errors import InputError
 from viscoadh_ros.experiment import choose_contact
@@ -47,6 +48,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def main(args: argparse.Namespace) -> int:
     if args.output.suffix not in (".yaml", ".yml"):
         raise InputError(f"--output must be a .yaml file (got {str(args.output)!r})")
+    refuse_overwrite([args.bag, args.scene], [("--output", args.output)])
     _, scene, experiment = open_experiment(args)
     contact = choose_contact(scene, args.contact, experiment.input_topic)
     free = parse_free(args.free, args.kelvin) if args.free else parameter_names(args.kelvin)

@@ -13,6 +13,7 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from viscoadh_ros.cli._paths import refuse_overwrite
 from viscoadh_ros.core.errors import InputError
 from viscoadh_ros.experiment import (
     Experiment,
@@ -91,6 +92,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def main(args: argparse.Namespace) -> int:
     if args.output.suffix != ".mcap":
         raise InputError(f"--output must be an .mcap file (got {str(args.output)!r})")
+    refuse_overwrite([args.bag, args.scene], [("--output", args.output), ("--json", args.json)])
     _, scene, experiment = open_experiment(args)
     contact = choose_contact(scene, args.contact, experiment.input_topic)
 
