@@ -180,6 +180,11 @@ def test_replay_of_node_log_reproduces_its_forces(node_run: NodeRun, tmp_path: P
         "measured_pull_off_force_N",
         "model_pull_off_force_N",
         "replay_speed_x_real_time",
+        "commands",
+        "commands_rejected",
+        "resets",
+        "parameter_changes",
+        "restarts",
     }
     assert summary["contact"] == "finger" and summary["force_topic"] == "/finger/wrench"
     logged = Bag(node_run.log)

@@ -619,7 +619,9 @@ def _depth_stretch(
     measured stamp steps to its time holding the depth when time has passed (`advance`),
     else reads the last output. Writes the inputs' columns and the measured forces."""
     before = sim.output.force
-    times = np.maximum(times, sim.time)
+    # The node steps to max(stamp, the contact's time): a command stamped before a hold tick
+    # it arrived after runs at the tick's time.
+    times = np.maximum.accumulate(np.maximum(times, sim.time))
     previous = np.concatenate(([sim.time], times[:-1]))
     steps = is_input | (times > previous)
     result = sim.step_depths(times[steps], depth[steps])

@@ -113,10 +113,15 @@ def main(args: argparse.Namespace) -> int:
         "force_topic": experiment.force_topic,
         "output": str(args.output),
         **summary.as_dict(),
+        **_event_counts(experiment),
     }
+    skipped = experiment.rejected_index.size
     print(
         f"replayed {experiment.input_ns.size} inputs of {contact.id} over {experiment.duration:.3f} s "
-        f"at {summary.speed:.3g}x real time\n"
+        f"at {summary.speed:.3g}x real time"
+        + (f" (skipped {skipped} the node rejected)" if skipped else "")
+        + (f" ({len(experiment.restarts)} resets/parameter changes applied)" if experiment.restarts else "")
+        + "\n"
         f"force error vs {experiment.force_topic}: RMSE {summary.rmse:.6g} N, max {summary.max_error:.6g} N "
         f"({summary.samples} samples)\n"
         f"pull-off force: measured {_pull_off_text(summary.measured_pull_off)}, "
@@ -126,6 +131,20 @@ def main(args: argparse.Namespace) -> int:
     if args.json is not None:
         args.json.write_text(json.dumps(result, indent=2) + "\n", encoding="utf-8")
     return 0
+
+
+def _event_counts(experiment: Experiment) -> dict[str, int]:
+    """What the node did besides accepting commands, as the summary reports it."""
+    from viscoadh_ros.experiment import PARAMETERS, RESET
+
+    kinds = [r.kind for r in experiment.restarts]
+    return {
+        "commands": int(experiment.input_ns.size + experiment.rejected_index.size),
+        "commands_rejected": int(experiment.rejected_index.size),
+        "resets": kinds.count(RESET),
+        "parameter_changes": kinds.count(PARAMETERS),
+        "restarts": len(kinds),
+    }
 
 
 def _pull_off_text(force: float | None) -> str:
@@ -150,12 +169,13 @@ def _write_output(
     fields = list(STATE_OUTPUT_FIELDS)
     rows = np.column_stack([run.input_columns[name] for name in fields]).astype(np.float64)
     columns = dict(zip(fields, rows.T, strict=True))
-    count = rows.shape[0]
+    received, rejected = experiment.counters
+    models = run.input_model if run.input_model is not None else np.full(rows.shape[0], run.model)
     state = {
         **columns,
-        "model": MODEL_CODES[run.model],
-        "commands_received": np.arange(1, count + 1),
-        "commands_rejected": 0,
+        "model": np.array([MODEL_CODES[name] for name in models.tolist()], dtype=np.uint8),
+        "commands_received": received,
+        "commands_rejected": rejected,
     }
     frame, stamps = scene.node.frame_id, experiment.input_ns
     if path.exists():
