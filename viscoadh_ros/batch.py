@@ -91,7 +91,7 @@ def call_task(task: str, path: str, options: Mapping[str, Any]) -> dict[str, Any
     return row
 
 
-def _client(workers: int | None, scheduler: str | None) -> tuple[Any, Any]:
+def connect(workers: int | None, scheduler: str | None) -> tuple[Any, Any]:
     """``(client, cluster or None)``: connected to ``scheduler``, or to a new LocalCluster."""
     try:
         from dask.distributed import Client, LocalCluster
@@ -133,7 +133,7 @@ def run_batch(
         raise InputError(f"--workers must be >= 1 (got {workers})")
     from tqdm import tqdm
 
-    client, cluster = _client(workers, scheduler)
+    client, cluster = connect(workers, scheduler)
     rows: list[dict[str, Any] | None] = [None] * len(bags)
     try:
         from dask.distributed import as_completed
