@@ -274,7 +274,8 @@ def _write_output(
     import numpy as np
 
     from viscoadh_ros.io import cdr
-    from viscoadh_ros.io.mcap_log import TopicData, write_mcap
+    from viscoadh_ros.io.mcap_bulk import write_columns
+    from viscoadh_ros.io.mcap_log import TopicData
     from viscoadh_ros.ros.conversions import MODEL_CODES, STATE_OUTPUT_FIELDS
 
     fields = list(STATE_OUTPUT_FIELDS)
@@ -291,20 +292,20 @@ def _write_output(
     frame, stamps = scene.node.frame_id, experiment.input_ns
     if path.exists():
         path.unlink()
-    write_mcap(
+    write_columns(
         path,
         [
             TopicData(
                 f"/{contact_id}/state",
                 cdr.CONTACT_STATE,
                 stamps,
-                cdr.encode(cdr.CONTACT_STATE, stamps, frame, state),
+                cdr.encode_array(cdr.CONTACT_STATE, stamps, frame, state),
             ),
             TopicData(
                 f"/{contact_id}/wrench",
                 cdr.WRENCH,
                 stamps,
-                cdr.encode(cdr.WRENCH, stamps, frame, {"wrench.force.z": columns["force"]}),
+                cdr.encode_array(cdr.WRENCH, stamps, frame, {"wrench.force.z": columns["force"]}),
             ),
         ],
         scene=scene.to_dict(),

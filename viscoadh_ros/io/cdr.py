@@ -165,6 +165,16 @@ def encode(
 ) -> list[bytes]:
     """CDR payloads of ``type_name``, one per stamp (ns >= 0, shape (n,)), with the given
     field values (arrays of shape (n,) or scalars; fields not given are zero)."""
+    rows = encode_array(type_name, stamp_ns, frame_id, fields)
+    data, size = rows.tobytes(), rows.shape[1]
+    return [data[k : k + size] for k in range(0, len(data), size)]
+
+
+def encode_array(
+    type_name: str, stamp_ns: ArrayLike, frame_id: str, fields: Mapping[str, ArrayLike]
+) -> NDArray[np.uint8]:
+    """:func:`encode` as one (n, L) uint8 array: row k is the k-th payload (all of L bytes),
+    for writers that take columns (``io.mcap_bulk.write_columns``)."""
     stamps = np.asarray(stamp_ns, dtype=np.int64)
     frame = frame_id.encode()
     layout = _layout(type_name, len(frame))
@@ -181,6 +191,4 @@ def encode(
         if name not in known:
             raise KeyError(f"{type_name} has no field {name!r}")
         records[name] = values
-    size = layout.itemsize
-    data = records.tobytes()
-    return [data[k : k + size] for k in range(0, len(data), size)]
+    return records.view(np.uint8).reshape(stamps.shape[0], layout.itemsize)
