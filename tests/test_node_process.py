@@ -21,9 +21,9 @@ from rclpy.node import Node
 from std_srvs.srv import Trigger
 from viscoadh_msgs.msg import ContactState, IndentationCommand
 from viscoadh_msgs.srv import PredictPullOff, SimulateHistory
-from viscoadh_ros.core.history import simulate_history
 
 from viscoadh_ros.core.config import SceneConfig
+from viscoadh_ros.core.history import simulate_history
 from viscoadh_ros.ros.conversions import ns_to_stamp
 
 VISCOADH = Path(sys.executable).parent / "viscoadh"
