@@ -122,23 +122,8 @@ def write_columns(
         raise ValueError("log times must be >= 0 ns")
     # Every topic's records, then one buffer in log-time order (ties as write_mcap breaks them).
     built = [_records(t + 1, ns, d.payloads) for t, (ns, d) in enumerate(zip(log_ns, topics, strict=True))]
-    which = np.concatenate([np.full(len(ns), t, dtype=np.int64) for t, ns in enumerate(log_ns)])
-    index = np.concatenate([np.arange(len(ns), dtype=np.int64) for ns in log_ns])
-    times = np.concatenate(log_ns)
-    order = np.lexsort((which, index, times))
-    sizes = np.concatenate([s for _, s in built])
-    sources = np.concatenate([np.cumsum(s) - s for _, s in built])  # start within its topic's bytes
-    base = np.cumsum([0] + [len(b) for b, _ in built])[:-1]
-    sources = sources + np.repeat(base, [len(s) for _, s in built])
-    everything = np.concatenate([b for b, _ in built]) if built else np.zeros(0, np.uint8)
-    sizes, sources, which, times = sizes[order], sources[order], which[order], times[order]
-    starts = np.cumsum(sizes) - sizes  # in the ordered stream
-    if sizes.size and np.all(sizes == sizes[0]):
-        # One record size (the usual replay output): reorder whole rows.
-        stream = everything.reshape(-1, int(sizes[0]))[sources // int(sizes[0])].reshape(-1)
-    else:
-        gather = np.repeat(sources - starts, sizes) + np.arange(int(sizes.sum()))
-        stream = everything[gather]
+    stream, sizes, which, times = _ordered(log_ns, built)
+    starts = np.cumsum(sizes) - sizes  # of each message record in the ordered stream
 
     builder = RecordBuilder()
     out = bytearray(_MAGIC)
@@ -248,6 +233,46 @@ def write_columns(
     Footer(summary_start=summary_start, summary_offset_start=offset_start, summary_crc=crc).write(builder)
     out += builder.end() + _MAGIC
     Path(path).write_bytes(out)
+
+
+def _ordered(
+    log_ns: list[NDArray[np.int64]], built: list[tuple[NDArray[np.uint8], NDArray[np.int64]]]
+) -> tuple[NDArray[np.uint8], NDArray[np.int64], NDArray[np.int64], NDArray[np.int64]]:
+    """``(stream, sizes, topic, log time)``: the records of all topics in file order, and each
+    record's size, topic index and log time in that order."""
+    if not built:
+        empty = np.zeros(0, np.int64)
+        return np.zeros(0, np.uint8), empty, empty, empty
+    n = log_ns[0].size
+    shared = all(ns.shape == (n,) and np.array_equal(ns, log_ns[0]) for ns in log_ns)
+    fixed = all(b.size == sizes.sum() and (n == 0 or np.all(sizes == sizes[0])) for b, sizes in built)
+    if len(built) > 1 and shared and fixed and np.all(np.diff(log_ns[0]) >= 0):
+        # Topics on the same non-decreasing log times (a state and its wrench per input): the
+        # order is the k-th message of each topic in turn, i.e. the topics' rows side by side.
+        count = len(built)
+        stream = np.concatenate([b.reshape(n, -1) for b, _ in built], axis=1).reshape(-1)
+        sizes = np.tile(np.array([s[0] for _, s in built], dtype=np.int64), n)
+        return stream, sizes, np.tile(np.arange(count), n), np.repeat(log_ns[0], count)
+    which = np.concatenate([np.full(len(ns), t, dtype=np.int64) for t, ns in enumerate(log_ns)])
+    index = np.concatenate([np.arange(len(ns), dtype=np.int64) for ns in log_ns])
+    times = np.concatenate(log_ns)
+    order = np.lexsort((which, index, times))
+    sizes = np.concatenate([s for _, s in built])
+    sources = np.concatenate([np.cumsum(s) - s for _, s in built])  # start within its topic's bytes
+    base = np.cumsum([0] + [len(b) for b, _ in built])[:-1]
+    sources = (sources + np.repeat(base, [len(s) for _, s in built]))[order]
+    everything = np.concatenate([b for b, _ in built])
+    sizes, which, times = sizes[order], which[order], times[order]
+    if sizes.size and np.all(sizes == sizes[0]):
+        # One record size: reorder whole rows.
+        return (
+            everything.reshape(-1, int(sizes[0]))[sources // int(sizes[0])].reshape(-1),
+            sizes,
+            which,
+            times,
+        )
+    starts = np.cumsum(sizes) - sizes
+    return everything[np.repeat(sources - starts, sizes) + np.arange(int(sizes.sum()))], sizes, which, times
 
 
 def _statistics(which: NDArray, times: NDArray, schemas: int, channels: int, chunks: int) -> Statistics:
