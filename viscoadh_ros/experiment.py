@@ -146,8 +146,8 @@ def _read_topic(bag: Bag, topic: str) -> tuple[NDArray[np.int64], NDArray[np.int
     :data:`_VALUE_FIELDS` of its type as arrays. Fixed-layout CDR is read in bulk; anything
     else message by message through rclpy."""
     type_name = bag.topics[topic]
-    log_ns, order, payloads = bag.raw(topic)
-    columns = cdr.decode(type_name, payloads)
+    log_ns, order, rows = bag.rows(topic)
+    columns = None if rows is None else cdr.decode(type_name, rows)
     if columns is None:
         messages = list(bag.messages([topic]))
         log_ns = np.array([m.log_time_ns for m in messages], dtype=np.int64)

@@ -130,19 +130,23 @@ class Packer:
         return bytes(buffer)
 
 
-def decode(type_name: str, payloads: Sequence[bytes]) -> dict[str, NDArray] | None:
-    """Every field of ``payloads`` (n CDR messages of ``type_name``) as arrays of shape (n,),
-    plus ``stamp_ns`` (int64, ns) for stamped types; None when they cannot be read in bulk."""
-    if type_name not in _FIELDS or not payloads:
+def decode(type_name: str, payloads: Sequence[bytes] | NDArray[np.uint8]) -> dict[str, NDArray] | None:
+    """Every field of ``payloads`` (n CDR messages of ``type_name``, or an (n, L) uint8 array of
+    them, see ``Bag.rows``) as arrays of shape (n,), plus ``stamp_ns`` (int64, ns) for stamped
+    types; None when they cannot be read in bulk."""
+    if type_name not in _FIELDS or not len(payloads):
         return None
-    length = len(payloads[0])
-    if any(len(p) != length for p in payloads):
-        return None  # frame ids of different lengths
+    if isinstance(payloads, np.ndarray):
+        head = np.ascontiguousarray(payloads, dtype=np.uint8)
+        length = head.shape[1]
+    else:
+        length = len(payloads[0])
+        if any(len(p) != length for p in payloads):
+            return None  # frame ids of different lengths
+        head = np.frombuffer(b"".join(payloads), np.uint8).reshape(len(payloads), length)
     stamped = _FIELDS[type_name][0]
     if length < (_HEADER + 12 if stamped else _HEADER):
         return None
-    buffer = b"".join(payloads)
-    head = np.frombuffer(buffer, np.uint8).reshape(len(payloads), length)
     if np.any(head[:, :_HEADER] != np.frombuffer(_ENCAPSULATION, np.uint8)):
         return None  # big endian or XCDR2: rclpy reads those
     frame = int(head[0, _HEADER + 8 : _HEADER + 12].view("<u4")[0]) - 1 if stamped else 0
@@ -151,7 +155,7 @@ def decode(type_name: str, payloads: Sequence[bytes]) -> dict[str, NDArray] | No
     layout = _layout(type_name, frame)
     if layout.itemsize != length:
         return None
-    records = np.frombuffer(buffer, layout)
+    records = head.view(layout).reshape(len(head))
     if stamped and np.any(records["frame_id.length"] != frame + 1):
         return None
     columns = {name: records[name].copy() for name, _ in _FIELDS[type_name][1]}
