@@ -6,9 +6,11 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import pytest
 
 from viscoadh_ros.bench.replay_speed import record_stream
 from viscoadh_ros.cli.main import main
+from viscoadh_ros.core.errors import InputError
 from viscoadh_ros.experiment import choose_contact, load_experiment, run_model
 from viscoadh_ros.io.bag import Bag
 from viscoadh_ros.ros import conversions
@@ -144,3 +146,50 @@ def _check_indexes(path: Path) -> int:
         for channel, offset in index.message_index_offsets.items():
             assert data[offset] == 0x07 and struct.unpack_from("<H", data, offset + 9)[0] == channel
     return checked
+
+
+@pytest.mark.parametrize("layout", ["chunked", "zstd", "lz4", "unchunked"])
+def test_bag_reads_every_layout_of_the_mcap_writer(tmp_path: Path, layout: str) -> None:
+    """Bag's own record walk against the mcap reader: compressed chunks, messages outside
+    chunks, a channel defined between messages, payloads of several lengths; then a cut file
+    is refused, and read up to its last complete chunk with recover."""
+    from mcap.reader import make_reader
+    from mcap.writer import CompressionType, Writer
+
+    from viscoadh_ros.io import cdr
+    from viscoadh_ros.io.ros_schemas import schema_text
+
+    path = tmp_path / f"{layout}.mcap"
+    compression = {"zstd": CompressionType.ZSTD, "lz4": CompressionType.LZ4}.get(layout, CompressionType.NONE)
+    with open(path, "wb") as stream:
+        writer = Writer(stream, chunk_size=2048, compression=compression, use_chunking=layout != "unchunked")
+        writer.start(profile="ros2")
+        schema = writer.register_schema(cdr.WRENCH, "ros2msg", schema_text(cdr.WRENCH).encode())
+        first = writer.register_channel("/a/wrench", "cdr", schema)
+        for k in range(150):
+            if k == 70:
+                second = writer.register_channel("/b/wrench", "cdr", schema)
+            frame = "f" * (1 + 8 * (k % 3))
+            (payload,) = cdr.encode(cdr.WRENCH, [k * 1000], frame, {"wrench.force.z": float(k)})
+            channel = first if k < 70 or k % 2 else second
+            writer.add_message(channel, log_time=k * 1000, publish_time=k * 1000, data=payload, sequence=k)
+        writer.finish()
+    with open(path, "rb") as stream:
+        expected = sorted((c.topic, m.log_time, m.data) for _, c, m in make_reader(stream).iter_messages())
+    bag = Bag(path)
+    got = sorted(
+        (topic, t, data)
+        for topic in bag.topics
+        for t, data in zip(bag.raw(topic)[0].tolist(), bag.raw(topic)[2], strict=True)
+    )
+    assert got == expected and len(got) == 150
+    assert bag.rows("/a/wrench")[2] is None, "frame ids of three lengths: no (n, L) array"
+
+    data = path.read_bytes()
+    path.write_bytes(data[: len(data) * 2 // 3])
+    with pytest.raises(InputError, match="truncated or damaged"):
+        Bag(path)
+    recovered = Bag(path, recover=True)
+    assert recovered.truncated == [path]
+    if layout != "unchunked":
+        assert 0 < sum(recovered.message_count(t) for t in recovered.topics) < 150
