@@ -257,3 +257,34 @@ def test_event_naming_a_command_the_log_lacks_is_an_error(tmp_path: Path, capsys
     assert main(["replay", str(path), "-o", str(tmp_path / "o.mcap")]) == 2
     err = capsys.readouterr().err
     assert "rejects command 7" in err and "incomplete" in err, err
+
+
+def test_recording_by_another_recorder_with_events_replays_by_the_node_rules(
+    session: tuple[Path, list[float], dict[str, int]], tmp_path: Path
+) -> None:
+    """The same session copied by a plain MCAP writer (what `ros2 bag record` makes: no
+    viscoadh metadata, so the scene comes from --scene): its `finger/events` make it a node
+    log all the same."""
+    from mcap.reader import make_reader
+    from mcap.writer import Writer
+
+    path, forces, _ = session
+    copy, scene_file = tmp_path / "rosbag.mcap", tmp_path / "scene.yaml"
+    with open(path, "rb") as source, open(copy, "wb") as target:
+        reader, writer = make_reader(source), Writer(target)
+        writer.start(profile="ros2")
+        channels: dict[int, int] = {}
+        for schema, channel, message in reader.iter_messages(log_time_order=False):
+            if channel.id not in channels:
+                schema_id = writer.register_schema(schema.name, schema.encoding, schema.data)
+                channels[channel.id] = writer.register_channel(channel.topic, "cdr", schema_id)
+            writer.add_message(channels[channel.id], message.log_time, message.data, message.publish_time)
+        writer.finish()
+    assert Bag(copy).software_version is None and Bag(copy).scene() is None
+    scene_file.write_text(yaml.safe_dump(plain(SCENE.to_dict()), sort_keys=False))
+    summary_path = tmp_path / "summary.json"
+    args = ["replay", str(copy), "--scene", str(scene_file), "-o", str(tmp_path / "o.mcap")]
+    assert main([*args, "--json", str(summary_path)]) == 0
+    summary = json.loads(summary_path.read_text())
+    assert summary["max_error_N"] <= 1e-9 * max(abs(f) for f in forces), summary
+    assert summary["commands_rejected"] == 3 and summary["restarts"] == 2, summary

@@ -15,8 +15,9 @@ has one (a zero stamp means "on receipt"), else the log time.
 
 Two orders of events:
 
-- A **node log** (a file written by viscoadh's recorder, which stores the software version,
-  with IndentationCommand inputs) runs in recording order, which is the order the node
+- A **node log** (IndentationCommand inputs in a file written by viscoadh's recorder, which
+  stores the software version, or in any recording that holds the contact's ``C/events``)
+  runs in recording order, which is the order the node
   handled things in: it logs each command on receipt, before its answer, and its hold-timer
   states as it publishes them. The node's verdicts are applied as the node made them: a
   command refused by the node (a ``COMMAND_REJECTED`` ``ContactEvent`` on ``C/events`` naming
@@ -254,7 +255,10 @@ def load_experiment(
     if stamps.size == 0:
         raise InputError(f"input topic {inputs!r} has no messages")
     mode, value = _inputs_of(bag.topics[inputs], columns)
-    by_arrival = bag.topics[inputs] == COMMAND and bag.software_version is not None
+    # A node's log: written by our recorder, or holding the contact's events.
+    by_arrival = bag.topics[inputs] == COMMAND and (
+        bag.software_version is not None or _events_topic(inputs) in bag.topics
+    )
     events_topic, restarts = None, ()
     if by_arrival:
         events_topic, restarts, refused = _node_events(bag, inputs, stamps, order, columns)
@@ -317,6 +321,11 @@ def load_experiment(
     )
 
 
+def _events_topic(inputs: str) -> str:
+    """``C/events`` beside ``C/indentation``."""
+    return inputs.rsplit("/", 1)[0] + "/events"
+
+
 def _node_events(
     bag: Bag,
     inputs: str,
@@ -326,7 +335,7 @@ def _node_events(
 ) -> tuple[str | None, tuple[Restart, ...], dict[int, str]]:
     """``(events topic, restarts, {command index: reason})`` from the ContactEvents logged
     beside ``inputs``; an event that names a command the log does not hold is an error."""
-    topic = inputs.rsplit("/", 1)[0] + "/events"
+    topic = _events_topic(inputs)
     if topic not in bag.topics:
         return None, (), {}
     if bag.topics[topic] != EVENT:
