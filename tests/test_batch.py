@@ -140,3 +140,22 @@ def test_fit_batch_calls_fit_file_per_bag(tmp_path: Path, monkeypatch: pytest.Mo
     rows = _rows(out / "summary.csv")
     assert [r["status"] for r in rows] == ["ok", "error"] and rows[1]["error"] == "no pull-off"
     assert rows[0]["G0_Pa_low"] == "900000.0" and rows[1]["G0_Pa"] == ""
+
+
+def test_replay_batch_on_an_existing_scheduler(tmp_path: Path) -> None:
+    """--scheduler: the bags run on a cluster someone else started (here an in-process one);
+    the cluster stays up afterwards."""
+    from dask.distributed import Client, LocalCluster
+
+    bags = [tmp_path / f"{name}.mcap" for name in ("x", "y")]
+    for bag in bags:
+        record_stream(bag, 0.03)
+    with LocalCluster(n_workers=1, threads_per_worker=2, processes=False, dashboard_address=None) as cluster:
+        out = tmp_path / "out"
+        assert (
+            main(["replay", *map(str, bags), "--scheduler", cluster.scheduler_address, "-o", str(out)]) == 0
+        )
+        rows = _rows(out / "summary.csv")
+        assert [r["status"] for r in rows] == ["ok", "ok"] and all(float(r["samples"]) > 0 for r in rows)
+        with Client(cluster.scheduler_address) as client:
+            assert len(client.scheduler_info()["workers"]) == 1, "the user's cluster is left running"
