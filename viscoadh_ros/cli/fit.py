@@ -48,7 +48,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="K",
         help="number of Kelvin elements of the rheology (default 1: standard solid)",
     )
-    parser.add_argument("-o", "--output", type=Path, required=True, help="scene YAML to write")
+    parser.add_argument(
+        "-o", "--output", type=Path, required=True, help="scene YAML to write (a folder in batch mode)"
+    )
 
 
 def main(args: argparse.Namespace) -> int:

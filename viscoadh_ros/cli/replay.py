@@ -157,7 +157,9 @@ def open_experiment(args: argparse.Namespace) -> tuple[Bag, SceneConfig, Experim
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_input_arguments(parser)
-    parser.add_argument("-o", "--output", type=Path, required=True, help="output .mcap file")
+    parser.add_argument(
+        "-o", "--output", type=Path, required=True, help="output .mcap file (a folder in batch mode)"
+    )
     parser.add_argument("--json", type=Path, help="also write the summary to this JSON file")
 
 
