@@ -366,7 +366,7 @@ def _node_events(
             )
         else:
             raise InputError(f"{topic}: event of unknown kind {event.kind} at {message.log_time_ns} ns")
-    return topic, tuple(restarts), refused
+    return topic, tuple(sorted(restarts, key=lambda r: r.order)), refused
 
 
 def _node_verdicts(
