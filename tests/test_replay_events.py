@@ -46,7 +46,9 @@ MS = 1_000_000
 
 class NodeRules:
     """One contact handled by the node's rules (ros/node.py ``_Contact.on_command``,
-    ``on_timer``, ``_reset_locked``, ``replace_config_locked``), logging what the node logs."""
+    ``on_timer``, ``_reset_locked``, ``replace_config_locked`` of the node that logs events:
+    a contact with no command since start, reset or a parameter change is left at rest by the
+    hold timer), logging what the node logs."""
 
     def __init__(self, contact: ContactConfig, recorder: McapRecorder, *, events: bool = True) -> None:
         self.events = events  # False: a 0.1.0 node, which logged no events
@@ -108,11 +110,12 @@ class NodeRules:
         return True
 
     def tick(self, now_ns: int) -> None:
-        target = self._sim_time(now_ns)
-        if target > self.sim.time:
-            output = self.sim.step(target, **self.hold) if self.hold else self.sim.advance(target)
-        else:
-            output = self.sim.output
+        # No command since start or reset: nothing to hold, the contact stays at rest.
+        output = self.sim.output
+        if self.last_command is not None:
+            target = self._sim_time(now_ns)
+            if target > self.sim.time:
+                output = self.sim.step(target, **self.hold)
         self._publish(output, now_ns, now_ns)
 
     def reset(self, now_ns: int) -> None:
@@ -125,6 +128,7 @@ class NodeRules:
         assert self.sim.is_idle, "the node changes a contact's parameters only when idle"
         self.sim, self.contact = ContactSimulator(contact), contact
         self.epoch = self.last_command = None
+        self.hold = {}
         scene = dataclasses.replace(SCENE, contacts=(contact,))
         self._event(
             ContactEvent.PARAMETERS,

@@ -24,8 +24,9 @@ Two orders of events:
   its index among the commands received; or, in logs without events, what the node always
   refuses: an unknown mode, a non-finite value, a stamp older than the last accepted command's)
   is skipped; a ``RESET`` or ``PARAMETERS`` event restarts the contact at its place in the
-  log (fresh state; PARAMETERS with the contact configuration it carries), and the next
-  accepted command starts a new time base, as in the node.
+  log (fresh state, at rest until the next accepted command; PARAMETERS with the contact
+  configuration it carries), and the next accepted command starts a new time base, as in the
+  node.
 - Any other recording runs by stamp; at equal stamps in recording order.
 """
 
@@ -515,18 +516,13 @@ def run_model(
     # Pieces between restarts; each: measured samples before its first input (the node's hold
     # timer on a fresh contact), then the inputs and samples from its first input on.
     cuts = np.flatnonzero(kind == 2)
-    hold: tuple[int, float] | None = None  # the last accepted control (mode, value)
     for lo, hi in zip(np.concatenate(([0], cuts + 1)), np.concatenate((cuts, [kind.size])), strict=True):
-        if lo > 0:
-            restart = restarts[int(index[lo - 1])]
-            if restart.kind == RESET:
-                hold = None
-            elif parameters:
-                contact = _contact_of(restart, contact.id)
+        if lo > 0 and parameters and restarts[int(index[lo - 1])].kind == PARAMETERS:
+            contact = _contact_of(restarts[int(index[lo - 1])], contact.id)
         inputs = np.flatnonzero(kind[lo:hi] == 0)
         first = lo + int(inputs[0]) if inputs.size else hi
         if first > lo:
-            _hold_fresh(contact, stamps[lo:first], index[lo:first], hold, model_force)
+            _at_rest(contact, index[lo:first], model_force)
         if first < hi:
             model = _run_piece(
                 contact,
@@ -537,8 +533,6 @@ def run_model(
                 columns,
                 model_force,
             )
-            last = int(index[first + int(np.flatnonzero(kind[first:hi] == 0)[-1])])
-            hold = (int(experiment.input_mode[last]), float(experiment.input_value[last]))
             input_model[index[first:hi][kind[first:hi] == 0]] = model
         if progress is not None:
             progress(int(hi - lo))
@@ -547,29 +541,13 @@ def run_model(
     )
 
 
-def _hold_fresh(
-    contact: ContactConfig,
-    stamps: NDArray[np.int64],
-    index: NDArray[np.int64],
-    hold: tuple[int, float] | None,
-    model_force: NDArray[np.float64],
-) -> None:
-    """Measured samples after a restart, before the next input: the node's hold timer on a
-    fresh contact, whose time base starts at the first of them, holding the last accepted
-    control (kept through a parameter change, forgotten by a reset)."""
+def _at_rest(contact: ContactConfig, index: NDArray[np.int64], model_force: NDArray[np.float64]) -> None:
+    """Measured samples after a restart, before the next accepted command: the node's hold
+    timer leaves a contact that has had no command since start or reset alone (nothing to hold;
+    holding depth 0 would touch the surface), so it publishes the fresh contact's output."""
     from viscoadh_ros.core.simulator import ContactSimulator
 
-    sim = ContactSimulator(contact)
-    for stamp, i in zip(stamps.tolist(), index.tolist(), strict=True):
-        t = (stamp - int(stamps[0])) * 1e-9
-        if t > sim.time:
-            if hold is None:
-                output = sim.advance(t)
-            else:
-                output = sim.step(t, **{"depth" if hold[0] == DEPTH else "force": hold[1]})
-        else:
-            output = sim.output
-        model_force[i] = output.force
+    model_force[index] = ContactSimulator(contact).output.force
 
 
 def _run_piece(
