@@ -140,3 +140,21 @@ def test_ambiguous_contact_and_bad_model_are_errors(scene: Path, tmp_path: Path,
         == 2
     )
     assert "numerics.model" in capsys.readouterr().err
+
+
+def test_a_history_with_a_byte_order_mark_is_read(scene: Path, tmp_path: Path) -> None:
+    """Spreadsheets save 'CSV UTF-8' with a BOM; the header must still read 'time,depth'."""
+    history = tmp_path / "excel.csv"
+    history.write_text("time,depth\n0,0\n0.1,1e-6\n", encoding="utf-8-sig")
+    out = tmp_path / "o.csv"
+    assert main(["simulate", str(scene), str(history), "-o", str(out), "--contact", "finger"]) == 0
+    assert read_result(out)["depth"].tolist() == [0.0, 1e-6]
+
+
+def test_an_output_in_a_missing_folder_is_refused_before_running(scene: Path, tmp_path: Path, capsys) -> None:
+    history = write_history(tmp_path / "h.csv", "time,depth", np.array([[0.0, 1e-6]]))
+    out = tmp_path / "missing" / "o.csv"
+    assert main(["simulate", str(scene), str(history), "-o", str(out), "--contact", "finger"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "does not exist" in err and "\n" not in err, err
+    assert not out.parent.exists(), "no folder is created"

@@ -11,6 +11,7 @@ import yaml
 from viscoadh_ros.core.config import (
     CONTACT_KEYS,
     NODE_KEYS,
+    PHYSICAL_RANGES,
     SceneConfig,
     default_scene_path,
     load_default_scene,
@@ -148,7 +149,7 @@ def test_keys_of_other_shapes_are_ignored_and_dropped():
     [
         (
             {"finger__material__kelvin_viscosities": [1e3, -3.0]},
-            r"^finger\.material\.kelvin_viscosities\[1\] must be > 0",
+            r"^finger\.material\.kelvin_viscosities\[1\] must be in \[1e-06, 1e\+15\] Pa s \(got -3\)",
         ),
         (
             {"finger__material__kelvin_viscosities": [1e3]},
@@ -181,7 +182,7 @@ def test_keys_of_other_shapes_are_ignored_and_dropped():
         ({"finger__indenter__radius": None}, r"^finger\.indenter\.radius is required for shape 'sphere'"),
         (
             {"finger__indenter": {"shape": "cone", "half_angle": 2.0}},
-            r"^finger\.indenter\.half_angle must be < pi/2",
+            r"^finger\.indenter\.half_angle must be in \[0\.001, 1\.5698\] rad \(got 2\)",
         ),
         ({"finger__indenter": {"shape": "cube"}}, r"^finger\.indenter\.shape must be one of"),
         (
@@ -194,8 +195,14 @@ def test_keys_of_other_shapes_are_ignored_and_dropped():
             },
             r"^finger\.indenter\.table_height must be non-decreasing",
         ),
-        ({"finger__adhesion__work_of_adhesion": -0.1}, r"^finger\.adhesion\.work_of_adhesion must be >= 0"),
-        ({"finger__adhesion__interaction_range": 0.0}, r"^finger\.adhesion\.interaction_range must be > 0"),
+        (
+            {"finger__adhesion__work_of_adhesion": -0.1},
+            r"^finger\.adhesion\.work_of_adhesion must be in \[0, 1000\]",
+        ),
+        (
+            {"finger__adhesion__interaction_range": 0.0},
+            r"^finger\.adhesion\.interaction_range must be in \[1e-12,",
+        ),
         ({"finger__numerics": {"preset": "quick"}}, r"^finger\.numerics\.preset must be one of"),
         ({"finger__numerics": {"elements": 2.5}}, r"^finger\.numerics\.elements must be an integer"),
         ({"contacts": []}, r"contacts must list at least one"),
@@ -219,6 +226,75 @@ def test_keys_of_other_shapes_are_ignored_and_dropped():
 def test_bad_scenes_name_the_key(changes, match):
     with pytest.raises(ConfigError, match=match):
         SceneConfig.from_dict(scene_with(**changes))
+
+
+@pytest.mark.parametrize(
+    "changes, match",
+    [
+        (
+            {"finger__material__glass_shear_modulus": 1e308},
+            r"glass_shear_modulus must be in \[1, 1e\+12\] Pa \(got 1e\+308\)",
+        ),
+        (
+            {"finger__material__glass_shear_modulus": 1e-300},
+            r"glass_shear_modulus must be in \[1, 1e\+12\] Pa \(got 1e-300\)",
+        ),
+        (
+            {"finger__material__kelvin_shear_moduli": [1e4, 1e-200]},
+            r"kelvin_shear_moduli\[1\] must be in \[1,",
+        ),
+        ({"finger__material__kelvin_viscosities": [1e300, 30.0]}, r"kelvin_viscosities\[0\] must be in"),
+        ({"finger__adhesion__work_of_adhesion": 1e300}, r"work_of_adhesion must be in \[0, 1000\] J/m\^2"),
+        (
+            {"finger__adhesion__interaction_range": 1e-300},
+            r"interaction_range must be in \[1e-12, 0\.001\] m",
+        ),
+        ({"finger__indenter__radius": 1e-300}, r"indenter\.radius must be in \[1e-09, 1000\] m"),
+        ({"finger__indenter__radius": 1e300}, r"indenter\.radius must be in"),
+        (
+            {"finger__indenter": {"shape": "power_law", "coefficient": 1.0, "exponent": 1e-300}},
+            r"exponent must be in \[0\.1, 10\]",
+        ),
+        ({"finger__indenter": {"shape": "cone", "half_angle": 1e-300}}, r"half_angle must be in \[0\.001,"),
+        (
+            {
+                "finger__material": {
+                    "prony_long_term_modulus": 1e5,
+                    "prony_moduli": [1e5],
+                    "prony_times": [1e300],
+                }
+            },
+            r"prony_times\[0\] must be in \[1e-09, 1e\+09\] s",
+        ),
+    ],
+    ids=[
+        "G0-huge",
+        "G0-tiny",
+        "G1-tiny",
+        "eta-huge",
+        "w-huge",
+        "h-tiny",
+        "R-tiny",
+        "R-huge",
+        "n-tiny",
+        "cone-flat",
+        "tau-huge",
+    ],
+)
+def test_numbers_outside_the_physical_range_are_refused_with_the_range(changes, match):
+    """Issue 11: G0 = 1e308 was refused naming an internal field, G0 = 1e-300 accepted (a
+    contact radius of 1e98 m). Every indenter/material/adhesion number has a documented range."""
+    with pytest.raises(ConfigError, match=match):
+        SceneConfig.from_dict(scene_with(**changes))
+
+
+def test_every_physical_range_is_documented():
+    text = (Path(__file__).resolve().parents[1] / "docs" / "configuration.md").read_text()
+    for key, (low, high, _) in PHYSICAL_RANGES.items():
+        row = next((line for line in text.splitlines() if line.startswith(f"| `{key.split('.')[1]}` |")), "")
+        assert f"{low:.6g}" in row and f"{high:.6g}" in row, (
+            f"{key}: range [{low:.6g}, {high:.6g}] not in {row!r}"
+        )
 
 
 def test_file_errors_are_config_errors(tmp_path):

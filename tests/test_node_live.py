@@ -17,7 +17,7 @@ from rclpy.exceptions import ParameterNotDeclaredException
 from rclpy.parameter import Parameter
 from rosgraph_msgs.msg import Clock
 from std_srvs.srv import Trigger
-from viscoadh_msgs.msg import ContactState, IndentationCommand
+from viscoadh_msgs.msg import ContactEvent, ContactState, IndentationCommand
 from viscoadh_msgs.srv import PredictPullOff, SimulateHistory
 from visualization_msgs.msg import Marker
 
@@ -44,6 +44,8 @@ SCENE: dict[str, Any] = {
     "visco.numerics.preset": "fast",
     # Keep the hold timer out of the way of command-driven tests.
     "publish_rate": 1.0,
+    # Commands are stamped ahead of the clock (see Client.t0), by up to 10 s in the threading test.
+    "command.max_future_s": 30.0,
 }
 TIMEOUT = 5.0
 T0_NS = 1_000_000_000_000  # /clock of the simulated-time test starts here, ns
@@ -212,6 +214,7 @@ def test_simulate_history_matches_the_core_and_leaves_the_live_state(client: Cli
     [
         (dict(mode=0, time=[0.0, 1.0], depth=[1e-6]), "mismatched lengths"),
         (dict(mode=0, time=[0.0, 1.0, 0.5], depth=[1e-6, 2e-6, 3e-6]), "non-monotonic time"),
+        (dict(mode=0, time=[0.0, 1.0, 1.0], depth=[1e-6, 2e-6, 3e-6]), "repeated time"),
         (dict(mode=0, time=[0.0, math.nan], depth=[1e-6, 2e-6]), "NaN time"),
         (dict(mode=0, time=[0.0, 1.0], depth=[1e-6, math.inf]), "inf depth"),
         (dict(mode=4, time=[0.0, 1.0], depth=[1e-6, 2e-6]), "unknown mode"),
@@ -224,10 +227,16 @@ def test_bad_history_request_is_refused(
     response = client.call(client.history, SimulateHistory.Request(**request_fields))
     assert not response.success, reason
     assert response.message, f"{reason}: the refusal must say why"
+    assert "np." not in response.message and " 1 samples" not in response.message, response.message
     assert node.contacts["elastic"].counters.requests_rejected == 1, reason
 
 
-@pytest.mark.parametrize("speed", [0.0, -1e-3, math.nan, math.inf])
+def test_simulate_history_of_one_sample(client: Client) -> None:
+    response = client.call(client.history, SimulateHistory.Request(mode=0, time=[0.0], depth=[1e-6]))
+    assert response.success and response.message == "1 sample", response.message
+
+
+@pytest.mark.parametrize("speed", [0.0, -1e-3, math.nan, math.inf, 5e-324, 1e300])
 def test_predict_pull_off_refuses_a_bad_speed(client: Client, speed: float) -> None:
     client.send(_command(client.t0, depth=5e-6))
     response = client.call(client.pull_off, PredictPullOff.Request(retract_speed=speed))
@@ -297,6 +306,8 @@ def test_hold_timer_relaxes_and_clock_jump_back_resets(
     ros_executor.add_node(node)
     client = Client(ros_context, ros_executor, spin_until, contact="visco")
     clock = client.node.create_publisher(Clock, "/clock", 10)
+    events: list[ContactEvent] = []
+    client.node.create_subscription(ContactEvent, "visco/events", events.append, 10)
 
     def tick(ns: int) -> None:
         clock.publish(Clock(clock=ns_to_stamp(ns)))
@@ -315,6 +326,8 @@ def test_hold_timer_relaxes_and_clock_jump_back_resets(
     assert held.force < pressed.force, "the force relaxes while holding"
     tick(T0_NS + 10**9)  # the bag looped
     assert spin_until(ros_executor, lambda: node.contacts["visco"].last_command_ns is None, TIMEOUT)
+    assert spin_until(ros_executor, lambda: bool(events), TIMEOUT), "the reset is an event"
+    assert events[-1].kind == ContactEvent.RESET and "clock jumped back" in events[-1].reason
     state = client.send(_command(T0_NS + 10**9, depth=-1e-6))
     assert state is not None and state.phase == ContactState.NO_CONTACT, "reset after the jump"
 
@@ -333,9 +346,9 @@ def test_diagnostics_and_markers(ros_context: Any, ros_executor: Any, spin_until
     client.send(_command(0, depth=math.nan), expect_state=False)
     assert spin_until(ros_executor, lambda: arrays and any(m.type == Marker.SPHERE for m in marks), 3.0)
     status = {s.name: {kv.key: kv.value for kv in s.values} for s in arrays[-1].status}
-    assert set(status) == {"viscoadh: elastic", "viscoadh: visco"}
-    elastic = status["viscoadh: elastic"]
-    assert elastic["model"] == "closed_form" and status["viscoadh: visco"]["model"] == "time_stepped"
+    assert set(status) == {"/viscoadh: elastic", "/viscoadh: visco"}, "named after the node's full name"
+    elastic = status["/viscoadh: elastic"]
+    assert elastic["model"] == "closed_form" and status["/viscoadh: visco"]["model"] == "time_stepped"
     assert elastic["commands_received"] == "1" and elastic["commands_rejected"] == "1"
     disc = next(m for m in marks if m.type == Marker.CYLINDER and m.action == Marker.ADD)
     assert disc.scale.x > 0.0, "contact disc drawn with the contact diameter"

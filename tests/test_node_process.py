@@ -44,6 +44,8 @@ SCENE = {
                 "adhesion": {"work_of_adhesion": 0.05},
                 "numerics": {"preset": "fast"},
             },
+            # The test stamps its commands 1 s ahead of the clock.
+            "command": {"max_future_s": 10.0},
         }
     }
 }
@@ -89,6 +91,10 @@ def test_node_process_serves_a_controller_like_the_core(
         START_TIMEOUT,
     )
     assert up and node_process.poll() is None, (tmp_path / "node.log").read_text()
+    # The node's state publisher may not have matched our subscription yet (discovery is not
+    # symmetric; a reliable volatile writer drops what it published before): its idle heartbeat
+    # (once per second) arriving proves it has.
+    assert spin_until(executor, lambda: bool(states), START_TIMEOUT), "no idle heartbeat state"
 
     # Slow approach and retract, stamped 1 s ahead of the clock (see test_node_live).
     time = np.arange(0.0, 0.6, 0.01)
@@ -102,7 +108,8 @@ def test_node_process_serves_a_controller_like_the_core(
         pub.publish(msg)
         # The answer carries the command's stamp (idle heartbeats carry the clock's).
         assert spin_until(executor, lambda s=stamp: states and states[-1].header.stamp == s, TIMEOUT), (
-            f"no state at t={t}"
+            f"no state at t={t}: {[(x.header.stamp, x.commands_received) for x in states[-3:]]}\n"
+            + (tmp_path / "node.log").read_text()
         )
         forces.append(states[-1].force)
 

@@ -59,8 +59,15 @@ def test_plot_loops_normalised_needs_reference(tmp_path: Path) -> None:
         ("a,b\n1,2\n3,4\n", [], "lacks the columns"),
         ("depth,force,contact_radius\n1,2,3\n", [], "fewer than two rows"),
         ("depth,force,contact_radius\n1,2,3\n2,3,4\n", ["-o", "fig.pdf"], "must be a .png or .svg"),
+        (
+            "depth,force,contact_radius\n1,2,3\n2,nan,4\n3,4,5\n",
+            [],
+            "in.csv:3: column 'force' must be finite",
+        ),
+        ("depth,force,contact_radius\n1,2,3\n2,abc,4\n", [], "in.csv:3: column 'force' is not a number"),
+        ("depth,force,contact_radius\n1,2,3\n2,3,4\n", ["-o", "missing/fig.png"], "does not exist"),
     ],
-    ids=["columns", "rows", "format"],
+    ids=["columns", "rows", "format", "nan-row", "text-row", "missing-folder"],
 )
 def test_plot_bad_input(
     tmp_path: Path, capsys: pytest.CaptureFixture, content: str, args: list, expected: str
@@ -71,3 +78,10 @@ def test_plot_bad_input(
     code = main(["plot", str(csv), "-o", str(tmp_path / out)])
     err = capsys.readouterr().err.strip().splitlines()
     assert code == 2 and len(err) == 1 and expected in err[0], err
+    assert not (tmp_path / "missing").exists(), "no folder is created"
+
+
+def test_plot_reads_a_csv_with_a_byte_order_mark(tmp_path: Path) -> None:
+    csv = tmp_path / "excel.csv"
+    csv.write_text("depth,force,contact_radius\n0,0,0\n1e-6,1e-3,1e-4\n", encoding="utf-8-sig")
+    assert main(["plot", str(csv), "-o", str(tmp_path / "fig.png")]) == 0

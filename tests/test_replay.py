@@ -156,7 +156,7 @@ def test_node_log_read_by_rosbags_and_bag(node_run: NodeRun) -> None:
 
 
 def test_log_status_in_diagnostics(node_run: NodeRun) -> None:
-    statuses = [s for array in node_run.diagnostics for s in array.status if s.name == "viscoadh: log"]
+    statuses = [s for array in node_run.diagnostics for s in array.status if s.name == "/viscoadh: log"]
     assert statuses, "a logging node reports its log on /diagnostics"
     values: dict[str, Any] = {kv.key: kv.value for kv in statuses[-1].values}
     assert statuses[-1].level == DiagnosticStatus.OK, statuses[-1].message

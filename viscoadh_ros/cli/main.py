@@ -35,6 +35,7 @@ VERBS: dict[str, str] = {
     "fit": "viscoadh_ros.cli.fit",
     "plot": "viscoadh_ros.cli.plot",
     "bench": "viscoadh_ros.cli.bench",
+    "gripper": "viscoadh_ros.cli.gripper",
 }
 
 #: verb name -> one-line help shown by `viscoadh --help`.
@@ -46,6 +47,7 @@ HELP: dict[str, str] = {
     "fit": "identify material parameters from recorded force histories",
     "plot": "plot force-depth and force-radius loops from a result CSV or an MCAP log",
     "bench": "measure speed and accuracy of the numerics presets and the node on this machine",
+    "gripper": "MuJoCo pick-and-place whose adhesive pads are the viscoadh model (extra: gripper)",
 }
 
 ROS_ARGS_FLAG = "--ros-args"

@@ -14,6 +14,7 @@ import numpy as np
 
 from viscoadh_ros.cli._paths import refuse_overwrite
 from viscoadh_ros.core.errors import InputError
+from viscoadh_ros.io.csv_io import check_output_folder, read_columns
 from viscoadh_ros.plotting import Curve, JkrReference, plot_loops
 
 STATE = "viscoadh_msgs/msg/ContactState"
@@ -38,17 +39,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _csv_curves(path: Path) -> list[Curve]:
-    try:
-        table = np.genfromtxt(path, delimiter=",", names=True, dtype=np.float64, comments="#")
-    except (OSError, ValueError) as exc:
-        raise InputError(f"{str(path)!r} is not a readable CSV ({exc})") from None
-    names = table.dtype.names or ()
-    missing = [c for c in COLUMNS if c not in names]
-    if missing:
-        raise InputError(f"{str(path)!r} lacks the columns {missing} (has {list(names)})")
-    if table.size < 2:
+    table = read_columns(path, COLUMNS)
+    if table[COLUMNS[0]].size < 2:
         raise InputError(f"{str(path)!r} has fewer than two rows")
-    return [Curve(*(np.atleast_1d(table[c]) for c in COLUMNS), label=path.stem)]
+    return [Curve(*(table[c] for c in COLUMNS), label=path.stem)]
 
 
 def _mcap_curves(args: argparse.Namespace):
@@ -67,12 +61,19 @@ def _mcap_curves(args: argparse.Namespace):
         rows = np.array([(m.msg.depth, m.msg.force, m.msg.contact_radius) for m in bag.messages([topic])])
         if len(rows) < 2:
             raise InputError(f"topic {topic!r} has fewer than two states")
+        bad = np.flatnonzero(~np.isfinite(rows).all(axis=1))
+        if bad.size:
+            raise InputError(
+                f"topic {topic!r}: state {int(bad[0])} has a value that is not finite "
+                f"(depth, force, contact_radius = {', '.join(repr(float(v)) for v in rows[bad[0]])})"
+            )
         curves.append(Curve(rows[:, 0], rows[:, 1], rows[:, 2], label=topic))
     return curves, bag.scene()
 
 
 def main(args: argparse.Namespace) -> int:
     refuse_overwrite([args.input, args.scene], [("--output", args.output)])
+    check_output_folder(args.output)
     stored = None
     if args.input.suffix.lower() == ".csv":
         curves = _csv_curves(args.input)

@@ -27,8 +27,9 @@ def main(args: argparse.Namespace) -> int:
     from viscoadh_ros.core.config import SceneConfig
     from viscoadh_ros.core.history import simulate_history
     from viscoadh_ros.experiment import choose_contact
-    from viscoadh_ros.io.csv_io import read_history, write_result
+    from viscoadh_ros.io.csv_io import check_output_folder, read_history, write_result
 
+    check_output_folder(args.output)
     contact = choose_contact(SceneConfig.from_yaml(args.scene), args.contact)
     overrides = {k: v for k, v in (("preset", args.preset), ("model", args.model)) if v is not None}
     if overrides:

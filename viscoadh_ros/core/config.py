@@ -155,6 +155,8 @@ class NodeConfig:
     log_max_bytes [log.max_bytes]: rotate after this many bytes (0 = never).
     log_max_duration [log.max_duration]: rotate after this many seconds (0 = never).
     log_queue_size [log.queue_size]: bound of the writer queue, messages (> 0).
+    command_max_future_s [command.max_future_s]: how far ahead of the node clock a command's
+      ``header.stamp`` may be, s (>= 0); a command stamped further ahead is rejected.
     """
 
     publish_rate: float = 50.0
@@ -166,6 +168,7 @@ class NodeConfig:
     log_max_bytes: int = 0
     log_max_duration: float = 0.0
     log_queue_size: int = 10000
+    command_max_future_s: float = 1.0
 
 
 # --- schema: flat key -> (section dataclass field, kind) ------------------------------------
@@ -189,7 +192,7 @@ CONTACT_KEYS: dict[str, str] = {
 }
 #: node-level keys: "publish_rate" -> "float", "markers.enabled" -> "bool", ...
 NODE_KEYS: dict[str, str] = {
-    name.replace("markers_", "markers.").replace("log_", "log.", 1): kind
+    name.replace("markers_", "markers.").replace("log_", "log.", 1).replace("command_", "command.", 1): kind
     for name, kind in _kinds(NodeConfig).items()
 }
 _SHAPE_KEYS = {
@@ -198,6 +201,27 @@ _SHAPE_KEYS = {
     "flat_punch": ("radius",),
     "power_law": ("coefficient", "exponent"),
     "table": ("table_radius", "table_height"),
+}
+#: Physical range of every indenter, material and adhesion number, relative key -> (low, high,
+#: unit), both ends included (lists: every element). Outside it the model would compute with
+#: numbers no body has (G0 = 1e-300 Pa gives a contact radius of 1e98 m) or overflow (1e308 Pa);
+#: docs/configuration.md lists the same ranges.
+PHYSICAL_RANGES: dict[str, tuple[float, float, str]] = {
+    "indenter.radius": (1e-9, 1e3, "m"),
+    "indenter.half_angle": (1e-3, math.pi / 2 - 1e-3, "rad"),
+    "indenter.coefficient": (1e-30, 1e30, "m^(1-n)"),
+    "indenter.exponent": (0.1, 10.0, ""),
+    "indenter.table_radius": (0.0, 1e3, "m"),
+    "indenter.table_height": (0.0, 1e3, "m"),
+    "material.glass_shear_modulus": (1.0, 1e12, "Pa"),
+    "material.kelvin_shear_moduli": (1.0, 1e12, "Pa"),
+    "material.kelvin_viscosities": (1e-6, 1e15, "Pa s"),
+    "material.poisson_ratio": (0.0, 0.5, ""),
+    "material.prony_long_term_modulus": (1.0, 1e12, "Pa"),
+    "material.prony_moduli": (1.0, 1e12, "Pa"),
+    "material.prony_times": (1e-9, 1e9, "s"),
+    "adhesion.work_of_adhesion": (0.0, 1e3, "J/m^2"),
+    "adhesion.interaction_range": (1e-12, 1e-3, "m"),
 }
 _KELVIN_KEYS = ("glass_shear_modulus", "kelvin_shear_moduli", "kelvin_viscosities")
 _PRONY_KEYS = ("prony_long_term_modulus", "prony_moduli", "prony_times")
@@ -278,8 +302,26 @@ def _unknown_key(key: str, valid: list[str]) -> ConfigError:
     return ConfigError(f"unknown parameter {key!r}{hint}")
 
 
+def _check_range(key: str, value: Any) -> None:
+    """ConfigError naming ``key`` and its :data:`PHYSICAL_RANGES` entry if ``value`` (or an
+    element of it) lies outside."""
+    low, high, unit = PHYSICAL_RANGES[key.split(".", 1)[1]]
+    values = value if isinstance(value, tuple) else (value,)
+    for index, number in enumerate(values):
+        if not low <= number <= high:
+            name = f"{key}[{index}]" if isinstance(value, tuple) else key
+            raise ConfigError(
+                f"{name} must be in [{low:.6g}, {high:.6g}]{' ' + unit if unit else ''} (got {number:.6g})"
+            )
+
+
 def _build_contact(contact_id: str, given: dict[str, Any]) -> ContactConfig:
     """A validated ContactConfig from its coerced relative keys (``"indenter.radius"``...)."""
+    used = {f"indenter.{name}" for name in _SHAPE_KEYS.get(given.get("indenter.shape"), ())}
+    for key, value in given.items():
+        # Keys of other indenter shapes are ignored (see the module docstring), so not checked.
+        if key in PHYSICAL_RANGES and (key in used or not key.startswith("indenter.")):
+            _check_range(f"{contact_id}.{key}", value)
 
     def section(name: str) -> dict[str, Any]:
         return {k.split(".", 1)[1]: v for k, v in given.items() if k.startswith(f"{name}.")}
@@ -362,6 +404,7 @@ def _build_node(given: dict[str, Any]) -> NodeConfig:
         ("log.max_bytes", node.log_max_bytes >= 0, ">= 0"),
         ("log.max_duration", node.log_max_duration >= 0.0, ">= 0"),
         ("log.queue_size", node.log_queue_size > 0, "> 0"),
+        ("command.max_future_s", node.command_max_future_s >= 0.0, ">= 0"),
     ]
     for key, ok, bound in checks:
         if not ok:
@@ -383,6 +426,22 @@ _RosYamlLoader.add_implicit_resolver(
     ),
     list("-+0123456789."),
 )
+
+
+def read_yaml(path: str | Path, *, what: str = "scene file") -> Any:
+    """The YAML document in ``path``, read as ROS 2 reads params files; ConfigError (one line,
+    naming the file) when it cannot be read or parsed. A byte-order mark is accepted."""
+    file = Path(path)
+    try:
+        text = file.read_text(encoding="utf-8-sig")
+    except (OSError, UnicodeDecodeError) as error:
+        reason = error.strerror if isinstance(error, OSError) else str(error)
+        raise ConfigError(f"cannot read {what} {str(file)!r}: {reason}") from None
+    try:
+        return yaml.load(text, Loader=_RosYamlLoader)  # noqa: S506 - a SafeLoader subclass
+    except yaml.YAMLError as error:
+        detail = " ".join(str(error).split())
+        raise ConfigError(f"{what} {str(file)!r} is not valid YAML: {detail}") from None
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -444,14 +503,7 @@ class SceneConfig:
     def from_yaml(cls, path: str | Path) -> SceneConfig:
         """From a ROS 2 parameters YAML file (or a bare/flat mapping in YAML)."""
         file = Path(path)
-        try:
-            text = file.read_text(encoding="utf-8")
-        except OSError as error:
-            raise ConfigError(f"cannot read scene file {str(file)!r}: {error.strerror}") from None
-        try:
-            data = yaml.load(text, Loader=_RosYamlLoader)  # noqa: S506 - a SafeLoader subclass
-        except yaml.YAMLError as error:
-            raise ConfigError(f"scene file {str(file)!r} is not valid YAML: {error}") from None
+        data = read_yaml(file)
         if not isinstance(data, Mapping):
             raise ConfigError(f"scene file {str(file)!r} must hold a mapping of parameters")
         return cls.from_dict(data)

@@ -71,7 +71,7 @@ def _history_array(name: str, values: ArrayLike) -> FloatArray:
         raise InputError(f"{name} must be one-dimensional (got shape {array.shape})")
     bad = np.flatnonzero(~np.isfinite(array))
     if bad.size:
-        raise InputError(f"{name}[{int(bad[0])}] must be finite (got {array[bad[0]]!r})")
+        raise InputError(f"{name}[{int(bad[0])}] must be finite (got {float(array[bad[0]])!r})")
     return array
 
 
@@ -93,12 +93,15 @@ def simulate_history(
     if times.size == 0:
         raise InputError("time must have at least one sample")
     if control.size != times.size:
-        raise InputError(f"{control_name} has {control.size} samples but time has {times.size}")
+        raise InputError(
+            f"{control_name} has {_samples(control.size)} but time has {_samples(times.size)}"
+        )
     steps = np.flatnonzero(np.diff(times) <= 0.0)
     if steps.size:
         i = int(steps[0]) + 1
         raise InputError(
-            f"time must be strictly increasing (time[{i}] = {times[i]!r} after {times[i - 1]!r})"
+            f"time must be strictly increasing "
+            f"(time[{i}] = {float(times[i])!r} after {float(times[i - 1])!r})"
         )
     simulator = ContactSimulator(contact)
     simulator.reset(float(times[0]))
@@ -169,3 +172,8 @@ def predict_pull_off(simulator: ContactSimulator, retract_speed: float) -> PullO
             f"({PULL_OFF_RANGES} characteristic depth ranges); the values are up to there"
         )
     return PullOffPrediction(best_force, best_depth, elapsed, detached, message)
+
+
+def _samples(count: int) -> str:
+    """``"1 sample"``, ``"3 samples"``."""
+    return f"{count} sample{'' if count == 1 else 's'}"

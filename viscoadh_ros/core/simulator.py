@@ -353,10 +353,20 @@ class _TimeStepped:
         row = self.row
         assert row is not None
         length = row.length * self.numerics.growth_factor
-        if length > 1e6 * max(self.initial_length, 1e-300) and length > 1e3:
-            raise InputError("the contact grows without bound (adhesion beats the profile's rise)")
+        limit = max(1e6 * self.initial_length, 1e3)
+        if length > limit:
+            raise InputError(self._unrepresentable(limit))
         memory = _kernels.remap_memory(row, self.radius, depth, row.elements, length)
         self.row = self._build_row(length, memory)
+
+    def _unrepresentable(self, limit: float) -> str:
+        """Why a contact that needs a domain longer than ``limit`` (m) cannot be stepped."""
+        reach = float(np.asarray(self.physics.profile.g(limit)))
+        return (
+            "the contact would outgrow the largest domain this contact can represent (a contact "
+            f"radius of {limit:.3g} m, for this indenter a depth of about {reach:.3g} m): the depth "
+            "is beyond the scene's range, or adhesion beats the profile's rise"
+        )
 
     def _ensure_row(self, depth: float) -> bool:
         """Create the row if the indenter may touch; False if the step is trivially free."""
@@ -655,9 +665,21 @@ class ContactSimulator:
             raise InputError(f"time must not go backwards (got {t!r} after {self._time!r})")
         return t
 
+    # Every public stepping call is a transaction: on any exception (bad input, a contact the
+    # domain cannot represent, an interrupt) the state is restored from a snapshot taken
+    # before, bit for bit, so a refused step leaves nothing behind (the node relies on it).
     def step(self, time: float, *, depth: float | None = None, force: float | None = None) -> StepOutput:
         """Advance to `time` (s) under displacement control (`depth`, m) or force control
-        (`force`, N); exactly one of them. Returns the new StepOutput."""
+        (`force`, N); exactly one of them. Returns the new StepOutput. On any error the
+        state is left as it was before the call."""
+        snapshot = self.snapshot()
+        try:
+            return self._step(time, depth, force)
+        except BaseException:
+            self.restore(snapshot)
+            raise
+
+    def _step(self, time: float, depth: float | None, force: float | None) -> StepOutput:
         t = self._check_time(time)
         if (depth is None) == (force is None):
             raise InputError("step needs exactly one of depth or force")
@@ -673,7 +695,8 @@ class ContactSimulator:
 
     def advance(self, time: float) -> StepOutput:
         """Hold the last control until `time` (s): the last commanded force under force
-        control (the indenter creeps), else the current depth."""
+        control (the indenter creeps), else the current depth. On any error the state is
+        left as it was before the call."""
         if self._held_force is not None:
             return self.step(time, force=self._held_force)
         return self.step(time, depth=self._depth)
@@ -684,9 +707,17 @@ class ContactSimulator:
 
         times: s, shape (n,), non-decreasing, from `time` on; depths: m, shape (n,). Returns
         one array per `StepOutput` field (shape (n,); phase uint8, flags bool); the
-        simulator ends in the state of the last row, as after stepping. Nothing changes on
-        bad input.
+        simulator ends in the state of the last row, as after stepping. On bad input or any
+        other error (a row the domain cannot represent) nothing changes.
         """
+        snapshot = self.snapshot()
+        try:
+            return self._step_depths(times, depths)
+        except BaseException:
+            self.restore(snapshot)
+            raise
+
+    def _step_depths(self, times: np.ndarray, depths: np.ndarray) -> dict[str, np.ndarray]:
         t = np.ascontiguousarray(times, dtype=np.float64)
         d = np.ascontiguousarray(depths, dtype=np.float64)
         if t.ndim != 1 or t.shape != d.shape:
@@ -704,7 +735,7 @@ class ContactSimulator:
         if isinstance(self._model, _TimeStepped):
             radius, force, work, stored, gaps = self._model.advance_rows(self, t, d)
         else:
-            outputs = [self.step(float(ti), depth=float(di)) for ti, di in zip(t, d, strict=True)]
+            outputs = [self._step(float(ti), float(di), None) for ti, di in zip(t, d, strict=True)]
             return _columns(outputs)
         physics = self.physics
         r0 = np.concatenate(([self._output.contact_radius], radius[:-1]))

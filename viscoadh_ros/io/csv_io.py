@@ -2,8 +2,15 @@
 
 History: a header row ``time,depth`` (s, m) or ``time,force`` (s, N), then one sample per
 row; blank lines and lines starting with ``#`` are skipped. Errors name the file, the line
-number and the column. Result: a header row of the `HistoryResult.columns()` names, one row
-per input sample, floats written with ``repr`` precision (round-trips exactly).
+number and the column.
+
+Rules shared by every verb that reads or writes files (docs/cli.md): a UTF-8 file may start
+with a byte-order mark (spreadsheets write one); a number that is not finite (or not a
+number) is an error naming its line and column, never silently drawn or skipped; an output
+whose folder does not exist is an error (no folder is created).
+
+Result: a header row of the `HistoryResult.columns()` names, one row per input sample, floats
+written with ``repr`` precision (round-trips exactly).
 """
 
 from __future__ import annotations
@@ -32,19 +39,62 @@ class History:
     values: NDArray[np.float64]
 
 
-def read_history(path: str | Path) -> History:
-    """Read a history CSV; raises `InputError` naming the file, line and column."""
-    name = str(path)
+def check_output_folder(path: str | Path) -> None:
+    """InputError unless the folder ``path`` goes into exists (every verb's output rule)."""
+    folder = Path(path).parent
+    if not folder.is_dir():
+        raise InputError(f"output folder {str(folder)!r} of {str(path)!r} does not exist (create it first)")
+
+
+def _rows(path: str | Path, what: str) -> list[tuple[int, list[str]]]:
+    """(line number, stripped cells) of the non-blank, non-comment rows of a CSV file."""
     try:
-        with open(path, newline="", encoding="utf-8") as handle:
+        with open(path, newline="", encoding="utf-8-sig") as handle:
             lines = list(enumerate(csv.reader(handle), start=1))
     except (OSError, UnicodeDecodeError, csv.Error) as exc:
-        raise InputError(f"cannot read history {name!r}: {exc}") from None
-    rows = [
+        raise InputError(f"cannot read {what} {str(path)!r}: {exc}") from None
+    return [
         (n, [c.strip() for c in row])
         for n, row in lines
         if row and any(c.strip() for c in row) and not row[0].lstrip().startswith("#")
     ]
+
+
+def _number(name: str, line: int, column: str, text: str) -> float:
+    try:
+        number = float(text)
+    except ValueError:
+        raise InputError(f"{name}:{line}: column {column!r} is not a number ({text!r})") from None
+    if not math.isfinite(number):
+        raise InputError(f"{name}:{line}: column {column!r} must be finite (got {text!r})")
+    return number
+
+
+def read_columns(path: str | Path, columns: tuple[str, ...]) -> dict[str, NDArray[np.float64]]:
+    """The named columns of a CSV with a header row (other columns ignored), as float arrays;
+    InputError naming the file, line and column for a missing column or a bad number."""
+    name = str(path)
+    rows = _rows(path, "CSV")
+    if not rows:
+        raise InputError(f"{name}: empty file (expected a header row with {', '.join(columns)})")
+    header = rows[0][1]
+    missing = [c for c in columns if c not in header]
+    if missing:
+        raise InputError(f"{name!r} lacks the columns {missing} (has {header})")
+    index = [header.index(c) for c in columns]
+    values = np.empty((len(rows) - 1, len(columns)))
+    for i, (line, row) in enumerate(rows[1:]):
+        if len(row) != len(header):
+            raise InputError(f"{name}:{line}: expected {len(header)} columns, got {len(row)}")
+        for j, (column, k) in enumerate(zip(columns, index, strict=True)):
+            values[i, j] = _number(name, line, column, row[k])
+    return {column: values[:, j].copy() for j, column in enumerate(columns)}
+
+
+def read_history(path: str | Path) -> History:
+    """Read a history CSV; raises `InputError` naming the file, line and column."""
+    name = str(path)
+    rows = _rows(path, "history")
     if not rows:
         raise InputError(f"{name}: empty file (expected a header row time,depth or time,force)")
     header_line, header = rows[0]
@@ -60,13 +110,7 @@ def read_history(path: str | Path) -> History:
         if len(row) != 2:
             raise InputError(f"{name}:{line}: expected 2 columns (time,{control}), got {len(row)}")
         for j, column in enumerate(("time", control)):
-            try:
-                number = float(row[j])
-            except ValueError:
-                raise InputError(f"{name}:{line}: column {column!r} is not a number ({row[j]!r})") from None
-            if not math.isfinite(number):
-                raise InputError(f"{name}:{line}: column {column!r} must be finite (got {row[j]!r})")
-            values[i, j] = number
+            values[i, j] = _number(name, line, column, row[j])
         if i and values[i, 0] <= values[i - 1, 0]:
             raise InputError(
                 f"{name}:{line}: column 'time' must increase strictly "

@@ -41,6 +41,17 @@ METADATA_NAME = "viscoadh"
 #: Keys of that record.
 SCENE_KEY = "scene_yaml"
 VERSION_KEY = "software_version"
+#: Name of the metadata record a recorder writes into each file it finishes: messages it
+#: dropped (full queue) since it started, in total (:data:`DROPPED_KEY`) and per topic (YAML
+#: mapping, :data:`DROPPED_TOPICS_KEY`), so a reader knows whether the log is complete (a
+#: replay that counts commands must know). A file cut by SIGKILL has no such record.
+LOG_RECORD_NAME = "viscoadh_log"
+DROPPED_KEY = "messages_dropped"
+DROPPED_TOPICS_KEY = "dropped_by_topic"
+
+#: Bytes a message adds to a file besides its payload: the Message record's header (opcode,
+#: length, channel, sequence, two times: 31 B) and its MessageIndex entry (16 B).
+_MESSAGE_OVERHEAD = 31 + 16
 
 # rmw's RMW_DURATION_INFINITE as rosbag2 Jazzy writes it ({sec, nsec} of INT64_MAX ns).
 _INFINITE = {"sec": 9223372036, "nsec": 854775807}
@@ -162,6 +173,8 @@ class _File:
         self.first_ns: int | None = None
         self.last_ns = 0
         self.position = self.stream.tell()
+        # Bytes of messages in the writer's open chunk, not yet in the stream.
+        self.pending = 0
 
     def channel(self, topic: str, type_name: str, qos: TopicQos) -> int:
         """The channel id of ``topic``, registered (with its schema) on first use."""
@@ -197,12 +210,18 @@ class _File:
         if position != self.position:
             self.stream.flush()
             self.position = position
+            self.pending = 0
+        else:
+            self.pending += len(data) + _MESSAGE_OVERHEAD
 
     @property
     def size(self) -> int:
-        return self.stream.tell()
+        """Bytes the file holds so far, the open chunk included (it is still in the writer)."""
+        return self.stream.tell() + self.pending
 
-    def finish(self) -> None:
+    def finish(self, log_record: dict[str, str] | None = None) -> None:
+        if log_record is not None:
+            self.writer.add_metadata(LOG_RECORD_NAME, log_record)
         self.writer.finish()
         self.stream.close()
 
@@ -259,6 +278,7 @@ class McapRecorder:
         self._queue_size = queue_size
         self._pending: deque[_Item] = deque()
         self._dropped = 0
+        self._dropped_by_topic: Counter[str] = Counter()
         self._written = 0
         self._closed = False
         self._error: BaseException | None = None
@@ -322,11 +342,9 @@ class McapRecorder:
         return self._put(_Item(topic, type_name, payload, int(stamp_ns)))
 
     def _put(self, item: _Item) -> bool:
-        if self._closed or self._error is not None:
+        if self._closed or self._error is not None or len(self._pending) >= self._queue_size:
             self._dropped += 1
-            return False
-        if len(self._pending) >= self._queue_size:
-            self._dropped += 1
+            self._dropped_by_topic[item.topic] += 1
             return False
         self._pending.append(item)
         return True
@@ -363,7 +381,7 @@ class McapRecorder:
             and stamp_ns - current.first_ns >= self._max_duration_ns
         )
         if too_big or too_long:
-            current.finish()
+            current.finish(self._log_record())
             self._finished.append(current)
             self._file = None
 
@@ -387,13 +405,24 @@ class McapRecorder:
                 self._file.write(item, self._qos.get(item.topic, TopicQos()))
                 self._written += 1
             if self._file is not None:
-                self._file.finish()
+                self._file.finish(self._log_record())
                 self._finished.append(self._file)
                 self._file = None
             if self._folder is not None:
                 self._write_bag_metadata()
         except BaseException as exc:  # noqa: BLE001 - reported via .error, never into the node
             self._error = exc
+
+    def _log_record(self) -> dict[str, str]:
+        """The :data:`LOG_RECORD_NAME` record: drops so far (the writer thread reads the
+        counter the recording thread updates; a copy that races an update is retried)."""
+        while True:
+            try:
+                by_topic = dict(self._dropped_by_topic)
+                break
+            except RuntimeError:  # changed size during the copy
+                continue
+        return {DROPPED_KEY: str(self._dropped), DROPPED_TOPICS_KEY: yaml.safe_dump(by_topic)}
 
     def _write_bag_metadata(self) -> None:
         """rosbag2's ``metadata.yaml`` (version 9) so ``ros2 bag`` and rosbags open the folder."""

@@ -63,6 +63,15 @@ def command_control(msg: IndentationCommand) -> dict[str, float]:
     return {name: float(value)}
 
 
+def describe_command(msg: IndentationCommand) -> str:
+    """A command in a few words for a rejection reason: ``depth 1e+10 m``, ``force nan N``."""
+    if msg.mode == IndentationCommand.DEPTH:
+        return f"depth {msg.depth:g} m"
+    if msg.mode == IndentationCommand.FORCE:
+        return f"force {msg.force:g} N"
+    return f"mode {msg.mode}"
+
+
 def contact_state(
     output: StepOutput,
     *,
@@ -202,5 +211,6 @@ def history_response(result: HistoryResult, response: SimulateHistory.Response) 
     response.contact_radius = _sequence("d", result.contact_radius)
     response.phase = _sequence("B", result.phase)
     response.success = True
-    response.message = f"{len(response.force)} samples"
+    samples = len(response.force)
+    response.message = f"{samples} sample{'' if samples == 1 else 's'}"
     return response

@@ -1,7 +1,8 @@
 """/diagnostics for the node: per contact step time, command counters, model, validity.
 
 ``diagnostic_updater`` is not on PyPI, so the node builds its ``DiagnosticArray`` here: one
-``DiagnosticStatus`` per contact, named ``viscoadh: <id>``, published at about 1 Hz.
+``DiagnosticStatus`` per contact, named ``<node's fully qualified name>: <id>`` (two nodes in
+different namespaces stay apart on the one ``/diagnostics`` topic), published at about 1 Hz.
 """
 
 from __future__ import annotations
@@ -45,6 +46,8 @@ class ContactCounters:
     commands_received: int = 0
     commands_rejected: int = 0
     requests_rejected: int = 0
+    #: Publishers on C/indentation whose QoS does not match the node's (never heard).
+    incompatible_publishers: int = 0
     rejections_in_window: int = 0
     last_rejection: str = ""
     steps: StepTimer = field(default_factory=StepTimer)
@@ -63,6 +66,7 @@ def contact_status(
     contact_id: str,
     counters: ContactCounters,
     *,
+    node_name: str,
     model: str,
     scale_separation_ok: bool,
     in_contact: bool,
@@ -89,11 +93,12 @@ def contact_status(
         "commands_received": str(counters.commands_received),
         "commands_rejected": str(counters.commands_rejected),
         "requests_rejected": str(counters.requests_rejected),
+        "incompatible_publishers": str(counters.incompatible_publishers),
         "last_rejection": counters.last_rejection,
     }
     return DiagnosticStatus(
         level=DiagnosticStatus.WARN if problems else DiagnosticStatus.OK,
-        name=f"viscoadh: {contact_id}",
+        name=f"{node_name}: {contact_id}",
         hardware_id=contact_id,
         message="; ".join(problems) if problems else "OK",
         values=[KeyValue(key=k, value=v) for k, v in values.items()],
@@ -107,8 +112,10 @@ def diagnostic_array(statuses: list[DiagnosticStatus], *, stamp_ns: int) -> Diag
     return msg
 
 
-def log_status(*, written: int, dropped: int, error: BaseException | None) -> DiagnosticStatus:
-    """The status of the MCAP log (``viscoadh: log``): ERROR when the writer stopped, WARN once
+def log_status(
+    *, node_name: str, written: int, dropped: int, error: BaseException | None
+) -> DiagnosticStatus:
+    """The status of the MCAP log (``<node name>: log``): ERROR when the writer stopped, WARN once
     a message was dropped (the log is then incomplete for good), else OK."""
     if error is not None:
         level, message = DiagnosticStatus.ERROR, f"log writer stopped: {error}"
@@ -119,7 +126,7 @@ def log_status(*, written: int, dropped: int, error: BaseException | None) -> Di
     values = {"messages_written": str(written), "messages_dropped": str(dropped)}
     return DiagnosticStatus(
         level=level,
-        name="viscoadh: log",
+        name=f"{node_name}: log",
         hardware_id="mcap",
         message=message,
         values=[KeyValue(key=k, value=v) for k, v in values.items()],

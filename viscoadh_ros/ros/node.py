@@ -19,27 +19,31 @@ guards the simulator against the services and parameter changes, which run on ex
 from __future__ import annotations
 
 import contextlib
+import math
 import sys
 import threading
 import time
 from typing import Any, Protocol
 
 import rclpy
+import yaml
 from diagnostic_msgs.msg import DiagnosticArray
 from geometry_msgs.msg import WrenchStamped
 from rcl_interfaces.msg import SetParametersResult
 from rclpy.callback_groups import CallbackGroup, ReentrantCallbackGroup
 from rclpy.clock import JumpThreshold, TimeJump
 from rclpy.duration import Duration
+from rclpy.event_handler import SubscriptionEventCallbacks
 from rclpy.exceptions import InvalidHandle
 from rclpy.executors import ExternalShutdownException, MultiThreadedExecutor
 from rclpy.guard_condition import GuardCondition
 from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.node import Node
 from rclpy.parameter import Parameter
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy, qos_policy_name_from_kind
 from rosgraph_msgs.msg import Clock
 from std_srvs.srv import Trigger
-from viscoadh_msgs.msg import ContactState, IndentationCommand
+from viscoadh_msgs.msg import ContactEvent, ContactState, IndentationCommand
 from viscoadh_msgs.srv import PredictPullOff, SimulateHistory
 from visualization_msgs.msg import Marker
 
@@ -49,7 +53,7 @@ from viscoadh_ros.core.errors import ConfigError, InputError
 from viscoadh_ros.core.history import predict_pull_off, simulate_history
 from viscoadh_ros.core.simulator import ContactSimulator, StepOutput
 from viscoadh_ros.io import cdr
-from viscoadh_ros.io.mcap_log import McapRecorder
+from viscoadh_ros.io.mcap_log import McapRecorder, TopicQos, plain
 from viscoadh_ros.ros import conversions, diagnostics, markers, parameters
 
 NODE_NAME = "viscoadh"
@@ -60,6 +64,17 @@ DIAGNOSTICS_PERIOD_S = 1.0
 #: Minimum interval between two warnings of the same kind of rejection (throttled log), s.
 WARN_THROTTLE_S = 1.0
 _QOS_DEPTH = 10
+#: Commands are taken reliable (the ROS default), so none is lost while discovery completes; a
+#: best-effort publisher (sensor-data QoS) cannot match it and is warned about (see
+#: ``_Contact.on_incompatible_qos``). A best-effort subscription would match both, but it lost
+#: the first command of a child-process client whose publisher matched before the node's
+#: subscription did.
+COMMAND_QOS = QoSProfile(depth=_QOS_DEPTH, reliability=ReliabilityPolicy.RELIABLE)
+#: ``C/events`` keeps its last events for late joiners (a recorder started after the node).
+EVENTS_QOS = QoSProfile(
+    depth=100, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL
+)
+_NS_PER_S = 1_000_000_000
 #: GIL switch interval of the node process, s (CPython's default is 5 ms): how long the live
 #: thread, woken by a command, may wait for a service thread that holds the GIL in Python code.
 GIL_SWITCH_INTERVAL_S = 1e-4
@@ -108,6 +123,8 @@ class _Contact:
         self.last_command_ns: int | None = None
         self.last_clock_ns: int | None = None
         self.last_publish_ns: int | None = None
+        # Commands received on C/indentation since start (accepted or not): the next one's index.
+        self.commands_seen = 0
         # The last accepted control ({"depth": d} or {"force": f}); the hold timer keeps it, so
         # a contact under force control creeps at constant force between commands.
         self.hold: dict[str, float] = {}
@@ -120,14 +137,22 @@ class _Contact:
             IndentationCommand,
             f"{self.id}/indentation",
             self.on_command,
-            _QOS_DEPTH,
+            COMMAND_QOS,
             callback_group=live,
+            event_callbacks=SubscriptionEventCallbacks(incompatible_qos=self.on_incompatible_qos),
         )
+        # The subscription's QoS events would sit in the live group, which no executor runs:
+        # the services' executor serves them, so an incompatible publisher is reported.
+        for handler in self.subscription.event_handlers:
+            handler.callback_group = node.services_group
+            node.services_group.add_entity(handler)
+        self.events_pub = node.create_publisher(ContactEvent, f"{self.id}/events", EVENTS_QOS)
         self.timer = node.create_timer(1.0 / node.scene.node.publish_rate, self.on_timer, callback_group=live)
         # Resolved names, read per message for the log (rclpy's topic_name asks rcl each time).
         self.command_topic = self.subscription.topic_name
         self.state_topic = self.state_pub.topic_name
         self.wrench_topic = self.wrench_pub.topic_name
+        self.events_topic = self.events_pub.topic_name
         services = node.services_group
         node.create_service(
             SimulateHistory,
@@ -146,12 +171,15 @@ class _Contact:
     # --- clock -------------------------------------------------------------------------------
 
     def _sim_time(self, ns: int) -> float:
-        """Simulation time, s, of node-clock time ``ns`` (sets the epoch on first use)."""
-        if self.epoch_ns is None:
-            self.epoch_ns = ns
+        """Simulation time, s, of node-clock time ``ns``; -inf before the first command since
+        start or reset (the contact is then at rest and nothing moves it)."""
+        if self.last_command_ns is None:
+            return -math.inf
         return (ns - self.epoch_ns) * 1e-9
 
     def _reset_locked(self) -> None:
+        """Back to a contact that has received no command: at rest, out of touch. The hold
+        timer does not step it until a command brings it in (see :meth:`on_timer`)."""
         self.simulator.reset(time=0.0)
         self.epoch_ns = None
         self.last_command_ns = None
@@ -170,47 +198,108 @@ class _Contact:
 
     def clock_jumped_locked(self, back_s: float) -> None:
         """Reset after the clock went back by ``back_s`` seconds, with a warning."""
-        self.node.get_logger().warning(f"{self.id}: clock jumped back by {back_s:.3f} s; contact reset")
+        reason = f"clock jumped back by {back_s:.3f} s; contact reset"
+        self.node.get_logger().warning(f"{self.id}: {reason}")
         self._reset_locked()
         self.last_clock_ns = None
+        self.event_locked(ContactEvent.RESET, self.node.now_ns(), reason=reason)
+
+    def event_locked(
+        self,
+        kind: int,
+        now_ns: int,
+        *,
+        reason: str,
+        index: int = 0,
+        stamp: Any = None,
+        contact_yaml: str = "",
+    ) -> None:
+        """Publish a ContactEvent on ``C/events`` and log it (caller holds the lock, so the
+        log keeps the contact's events and commands in the order they took effect)."""
+        event = ContactEvent(kind=kind, contact_id=self.id, command_index=index, reason=reason)
+        event.header.stamp = conversions.ns_to_stamp(now_ns)
+        event.header.frame_id = self.node.frame_id
+        if stamp is not None:
+            event.command_stamp = stamp
+        event.contact_yaml = contact_yaml
+        self.events_pub.publish(event)
+        self.node.record(self.events_topic, event, now_ns)
+
+    def on_incompatible_qos(self, event: Any) -> None:
+        """A publisher on ``C/indentation`` whose QoS cannot match: its commands never arrive."""
+        policy = qos_policy_name_from_kind(event.last_policy_kind)
+        reason = (
+            f"a publisher on {self.command_topic} offers a QoS incompatible with the node's (last "
+            f"incompatible policy: {policy}); its commands are not received. The node subscribes "
+            "reliable, volatile, keep last 10: publish reliable (not best effort / sensor-data QoS)"
+        )
+        with self.lock:
+            self.counters.incompatible_publishers = event.total_count
+            self.counters.last_rejection = reason
+            self.counters.rejections_in_window += 1
+        self.node.get_logger().warning(f"{self.id}: {reason}")
 
     # --- live path ---------------------------------------------------------------------------
 
     def on_command(self, msg: IndentationCommand) -> None:
-        """Step to the command's stamp and publish the state at that stamp, or reject."""
-        now_ns = self.node.now_ns()
-        self.node.record(self.command_topic, msg, now_ns)
-        stamp_ns = conversions.stamp_to_ns(msg.header.stamp) or now_ns
+        """Step to the command's stamp and publish the state at that stamp, or reject it
+        (the contact unchanged, a COMMAND_REJECTED event with the reason)."""
         with self.lock:
+            now_ns = self.node.now_ns()
+            self.node.record(self.command_topic, msg, now_ns)
+            index = self.commands_seen
+            self.commands_seen = index + 1
             self._check_clock_locked(now_ns)
             try:
+                stamp_ns = self._command_stamp_locked(msg.header.stamp, now_ns)
                 control = conversions.command_control(msg)
-                if self.last_command_ns is not None and stamp_ns < self.last_command_ns:
-                    raise InputError(
-                        f"header.stamp {stamp_ns * 1e-9:.9f} s is older than the last "
-                        f"command's {self.last_command_ns * 1e-9:.9f} s"
-                    )
-                if self.last_command_ns is None:
-                    # First command since start or reset: the contact was at rest and nothing
-                    # says where the indenter was, so its history starts at this stamp (the
-                    # way simulate_history starts at its first sample).
-                    self.simulator.reset(time=0.0)
-                    self.epoch_ns = stamp_ns
+                # The first command since start or reset: nothing says where the indenter was
+                # before, so the contact's history starts at rest at this stamp (the way
+                # simulate_history starts at its first sample). Nothing changes until the step
+                # succeeded (the simulator's step is a transaction).
+                epoch_ns = stamp_ns if self.last_command_ns is None else self.epoch_ns
                 # A hold tick may have advanced the contact past a command that was stamped
                 # (just) before it: apply it now rather than go back in time.
-                target = max(self._sim_time(stamp_ns), self.simulator.time)
+                target = max((stamp_ns - epoch_ns) * 1e-9, self.simulator.time)
                 started = time.perf_counter()
                 output = self.simulator.step(target, **control)
                 self.counters.steps.add(time.perf_counter() - started)
             except ValueError as error:
-                self._reject_locked(f"command rejected: {error}", command=True)
+                reason = f"command rejected ({conversions.describe_command(msg)}): {error}"
+                self._reject_locked(reason, command=True)
+                self.event_locked(
+                    ContactEvent.COMMAND_REJECTED, now_ns, reason=reason, index=index, stamp=msg.header.stamp
+                )
                 return
             self.counters.commands_received += 1
+            self.epoch_ns = epoch_ns
             self.hold = control
             self.last_command_ns = stamp_ns
             self.last_publish_ns = now_ns
             state = self._state_locked(output, stamp_ns)
         self._publish(state, output, stamp_ns, now_ns)
+
+    def _command_stamp_locked(self, stamp: Any, now_ns: int) -> int:
+        """The command's stamp, ns on the node clock (zero: ``now_ns``); InputError for a stamp
+        that is malformed, too far ahead of the node clock, or older than the last command's."""
+        sec, nanosec = stamp.sec, stamp.nanosec
+        if sec < 0 or nanosec >= _NS_PER_S:
+            raise InputError(
+                f"header.stamp must have sec >= 0 and nanosec < 1000000000 (got sec {sec}, nanosec {nanosec})"
+            )
+        stamp_ns = sec * _NS_PER_S + nanosec or now_ns
+        if stamp_ns - now_ns > self.node.max_future_ns:
+            raise InputError(
+                f"header.stamp {stamp_ns * 1e-9:.9f} s is {(stamp_ns - now_ns) * 1e-9:.3f} s ahead of the "
+                f"node clock ({now_ns * 1e-9:.9f} s); command.max_future_s allows "
+                f"{self.node.max_future_ns * 1e-9:g} s"
+            )
+        if self.last_command_ns is not None and stamp_ns < self.last_command_ns:
+            raise InputError(
+                f"header.stamp {stamp_ns * 1e-9:.9f} s is older than the last "
+                f"command's {self.last_command_ns * 1e-9:.9f} s"
+            )
+        return stamp_ns
 
     def on_timer(self) -> None:
         """Between commands: advance the contact to now (hold, relaxation) and publish."""
@@ -224,17 +313,21 @@ class _Contact:
                     return
                 if self.simulator.is_idle and since < IDLE_PUBLISH_PERIOD_NS:
                     return
+            # No command since start or reset: the contact is out of touch and there is nothing
+            # to hold (holding depth 0 would touch the surface, and an adhesive contact snaps in).
             target = self._sim_time(now_ns)
+            output = self.simulator.output
             if target > self.simulator.time:
                 started = time.perf_counter()
-                # An accepted control held to a later time is valid input by construction.
-                if self.hold:
+                try:
                     output = self.simulator.step(target, **self.hold)
-                else:
-                    output = self.simulator.advance(target)
+                except ValueError as error:
+                    # Holding an accepted control rarely fails (a held force that creep makes
+                    # unreachable); the step changed nothing, the contact waits for a command.
+                    self.node.get_logger().warning(
+                        f"{self.id}: hold failed, state kept: {error}", throttle_duration_sec=WARN_THROTTLE_S
+                    )
                 self.counters.steps.add(time.perf_counter() - started)
-            else:
-                output = self.simulator.output
             self.last_publish_ns = now_ns
             state = self._state_locked(output, now_ns)
         self._publish(state, output, now_ns, now_ns)
@@ -303,24 +396,26 @@ class _Contact:
             config = self.config
             now_s = self._sim_time(now_ns)
         try:
+            speed = _retract_speed(request.retract_speed)
             copy = ContactSimulator(config)
             copy.restore(snapshot)
             if now_s > copy.time:
                 copy.advance(now_s)
-            prediction = predict_pull_off(copy, request.retract_speed)
+            prediction = predict_pull_off(copy, speed)
         except ValueError as error:
             return self._fail(response, f"predict_pull_off rejected: {error}")
         response.pull_off_force = float(prediction.pull_off_force)
         response.pull_off_depth = float(prediction.pull_off_depth)
         response.time_to_detach = float(prediction.time_to_detach)
         response.success = True
-        response.message = f"retracting at {request.retract_speed:g} m/s"
+        response.message = f"retracting at {speed:g} m/s"
         return response
 
     def on_reset(self, request: Trigger.Request, response: Trigger.Response) -> Trigger.Response:
         """Forget the contact's history: fresh, relaxed, out of touch."""
         with self.lock:
             self._reset_locked()
+            self.event_locked(ContactEvent.RESET, self.node.now_ns(), reason=f"{self.id}/reset called")
         response.success = True
         response.message = f"contact '{self.id}' reset"
         return response
@@ -334,12 +429,19 @@ class _Contact:
 
     # --- reconfiguration and diagnostics -----------------------------------------------------
 
-    def replace_config_locked(self, config: ContactConfig) -> None:
-        """Use ``config`` from now on (caller holds the lock and checked the contact is idle)."""
+    def replace_config_locked(self, config: ContactConfig, scene: SceneConfig) -> None:
+        """Use ``config`` from now on, a contact that has received no command (caller holds the
+        lock and checked the contact is idle); a PARAMETERS event carries the new contact."""
         self.config = config
         self.simulator = ContactSimulator(config)
-        self.epoch_ns = None
-        self.last_command_ns = None
+        self._reset_locked()
+        contact_scene = SceneConfig(contacts=(config,), node=scene.node)
+        self.event_locked(
+            ContactEvent.PARAMETERS,
+            self.node.now_ns(),
+            reason="parameters changed: contact restarted with the new physics",
+            contact_yaml=yaml.safe_dump(plain(contact_scene.to_dict()), sort_keys=False),
+        )
 
     def take_commands(self) -> None:
         """Handle every command waiting on the subscription (live thread)."""
@@ -359,6 +461,7 @@ class _Contact:
             return diagnostics.contact_status(
                 self.id,
                 self.counters,
+                node_name=self.node.get_fully_qualified_name(),
                 model=self.simulator.model,
                 scale_separation_ok=bool(output.scale_separation_ok),
                 in_contact=self.simulator.in_contact,
@@ -463,7 +566,9 @@ class _LiveLoop:
         except BaseException as error:
             # Not a bad command (those are rejected in on_command): a bug or a dead context.
             # Record it so main() stops the node rather than serve services without a live path.
-            if not self._stopping:
+            # rclpy's SIGINT/SIGTERM handler shuts the context down under a running thread: a
+            # publish or wait that fails then is the end of the run, not an error.
+            if not self._stopping and self._node.context.ok():
                 self.error = error
                 self._node.get_logger().fatal(f"live thread stopped: {error!r}")
                 raise
@@ -484,9 +589,13 @@ class ViscoadhNode(Node):
         self.frame_id = self.scene.node.frame_id
         self.payloads = conversions.LivePayloads(self.frame_id)
         self.markers_enabled = self.scene.node.markers_enabled
+        self.max_future_ns = round(self.scene.node.command_max_future_s * _NS_PER_S)
         # MCAP logging; None while logging is off. Opened before the endpoints exist, so the
         # log holds every command received and every state and wrench published.
-        self._recorder: Recorder | None = _open_recorder(self.scene)
+        events_qos = TopicQos(depth=EVENTS_QOS.depth, durability="transient_local")
+        self._recorder: Recorder | None = _open_recorder(
+            self.scene, {self.resolve_topic_name(f"{c.id}/events"): events_qos for c in self.scene.contacts}
+        )
         # Compile/load every numba kernel before the first command can arrive (~0.2 s).
         warm_up()
         warmed = time.perf_counter()
@@ -549,6 +658,7 @@ class ViscoadhNode(Node):
         if self._recorder is not None:
             statuses.append(
                 diagnostics.log_status(
+                    node_name=self.get_fully_qualified_name(),
                     written=self._recorder.written,
                     dropped=self._recorder.dropped,
                     error=self._recorder.error,
@@ -590,7 +700,7 @@ class ViscoadhNode(Node):
                         f"{contact_id}/reset)"
                     )
             for contact_id in touched:
-                self.contacts[contact_id].replace_config_locked(scene.contact(contact_id))
+                self.contacts[contact_id].replace_config_locked(scene.contact(contact_id), scene)
         if scene.node.publish_rate != self.scene.node.publish_rate:
             for contact in self.contacts.values():
                 contact.set_publish_rate(scene.node.publish_rate)
@@ -598,6 +708,7 @@ class ViscoadhNode(Node):
         if self.payloads.frame_id != self.frame_id:
             self.payloads = conversions.LivePayloads(self.frame_id)
         self.markers_enabled = scene.node.markers_enabled
+        self.max_future_ns = round(scene.node.command_max_future_s * _NS_PER_S)
         self.scene = scene
         return SetParametersResult(successful=True)
 
@@ -610,8 +721,9 @@ class ViscoadhNode(Node):
         super().destroy_node()
 
 
-def _open_recorder(scene: SceneConfig) -> McapRecorder | None:
-    """The MCAP recorder the scene's ``log.*`` parameters ask for (None when logging is off).
+def _open_recorder(scene: SceneConfig, qos: dict[str, TopicQos]) -> McapRecorder | None:
+    """The MCAP recorder the scene's ``log.*`` parameters ask for (None when logging is off);
+    ``qos``: offered QoS of the topics that differ from the default (``C/events``).
 
     The whole scene goes into the file's metadata record, so the log alone replays the run.
     """
@@ -625,7 +737,22 @@ def _open_recorder(scene: SceneConfig) -> McapRecorder | None:
         max_bytes=node.log_max_bytes,
         max_duration=node.log_max_duration,
         queue_size=node.log_queue_size,
+        qos=qos,
     )
+
+
+#: Retract speeds predict_pull_off accepts, m/s: slower, the retraction would not reach
+#: pull-off in a representable time; faster, nothing physical retracts.
+RETRACT_SPEED_RANGE = (1e-12, 1e3)
+
+
+def _retract_speed(value: float) -> float:
+    """``retract_speed`` as a float in :data:`RETRACT_SPEED_RANGE`, else InputError."""
+    low, high = RETRACT_SPEED_RANGE
+    speed = float(value)
+    if not low <= speed <= high:
+        raise InputError(f"retract_speed must be in [{low:g}, {high:g}] m/s (got {speed:g})")
+    return speed
 
 
 def _refuse(reason: str) -> SetParametersResult:
@@ -641,14 +768,29 @@ def main(args: list[str] | None = None) -> int:
     """
     # A command should not wait up to CPython's default 5 ms for a busy service thread.
     sys.setswitchinterval(GIL_SWITCH_INTERVAL_S)
-    rclpy.init(args=args)
+    try:
+        parameters.check_params_files(list(args or []))
+        rclpy.init(args=args)
+    except ConfigError as error:
+        print(f"viscoadh node: error: {error}", file=sys.stderr, flush=True)
+        return 2
+    except _rclpy.RCLError as error:
+        detail = " ".join(str(error).split())
+        print(f"viscoadh node: error: ROS arguments rejected: {detail}", file=sys.stderr, flush=True)
+        return 2
     node = None
     try:
         node = ViscoadhNode()
         executor = MultiThreadedExecutor()
         executor.add_node(node)
         while rclpy.ok() and node.live_error is None:
-            executor.spin_once(timeout_sec=0.5)
+            try:
+                executor.spin_once(timeout_sec=0.5)
+            except Exception:
+                # SIGINT/SIGTERM shut the context down between the check and the wait.
+                if rclpy.ok():
+                    raise
+                break
         if node.live_error is not None:
             print(f"viscoadh node: error: live path failed: {node.live_error!r}", file=sys.stderr, flush=True)
             return 1
@@ -659,6 +801,8 @@ def main(args: list[str] | None = None) -> int:
         pass
     finally:
         if node is not None:
+            logger = node.get_logger()
             node.destroy_node()
+            logger.info("finished")
         rclpy.try_shutdown()
     return 0

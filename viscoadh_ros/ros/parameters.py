@@ -30,7 +30,8 @@ from rcl_interfaces.msg import (
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
-from viscoadh_ros.core.config import CONTACT_KEYS, NODE_KEYS, SceneConfig, load_default_scene
+from viscoadh_ros.core.config import CONTACT_KEYS, NODE_KEYS, SceneConfig, load_default_scene, read_yaml
+from viscoadh_ros.core.errors import ConfigError
 
 #: Parameters every rclpy node declares itself; they are not part of the scene.
 _RCLPY_PARAMETERS = frozenset({"use_sim_time", "start_type_description_service"})
@@ -38,7 +39,7 @@ _RCLPY_PARAMETERS = frozenset({"use_sim_time", "start_type_description_service"}
 _RCLPY_PREFIXES = ("qos_overrides.",)
 
 #: Node-level parameters that the node applies at runtime without touching any contact.
-RUNTIME_NODE_PARAMETERS = frozenset({"publish_rate", "frame_id", "markers.enabled"})
+RUNTIME_NODE_PARAMETERS = frozenset({"publish_rate", "frame_id", "markers.enabled", "command.max_future_s"})
 
 _INF = math.inf
 
@@ -145,6 +146,12 @@ _NODE_SPECS: dict[str, _Spec] = {
         "out through the indenter."
     ),
     "markers.enabled": _Spec("Publish C/marker (contact disc and indenter) for RViz/Foxglove."),
+    "command.max_future_s": _Spec(
+        "How far ahead of the node clock a command's header.stamp may be, s; a command stamped "
+        "further ahead is rejected (it would move the contact's time).",
+        low=0.0,
+        high=_INF,
+    ),
     "log.enabled": _Spec("Record commands, states and wrenches to MCAP.", read_only=True),
     "log.path": _Spec("MCAP file or folder for the log.", read_only=True),
     "log.chunk_size": _Spec("MCAP chunk size, bytes.", low=1, high=2**31 - 1, read_only=True),
@@ -291,3 +298,17 @@ def classify_change(name: str, contact_ids: tuple[str, ...]) -> str | None:
     if name in _NODE_SPECS or name.startswith("log."):
         return ""
     return None
+
+
+def check_params_files(args: list[str]) -> None:
+    """Read every ``--params-file FILE`` of the ROS arguments ``args`` before rclpy does, so a
+    missing or unparsable file is one ConfigError line naming it (rcl's own error is a
+    traceback). The scene inside is validated later, by the node, like any parameters."""
+    for flag, value in zip(args, args[1:], strict=False):
+        if flag == "--params-file":
+            data = read_yaml(value, what="params file")
+            if not isinstance(data, Mapping):
+                raise ConfigError(
+                    f"params file {value!r} must hold a mapping ({{node name or /**: "
+                    f"{{ros__parameters: ...}}}}), got {type(data).__name__}"
+                )

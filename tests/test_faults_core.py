@@ -1,0 +1,104 @@
+"""Fault suite, core side: a refused step leaves the simulator bit-identical.
+
+Each case feeds two simulators of one scene the same good commands and one of them a bad
+one in between; the bad one must raise with a reason, and the next good command must give
+both exactly the same output (the twin never saw the bad command). Scenes are time-stepped
+(numerics.model: time_stepped forces the 1D model, where the domain can grow) unless a case
+says it exercises the closed form.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+import pytest
+
+from viscoadh_ros.core.config import SceneConfig
+from viscoadh_ros.core.errors import InputError
+from viscoadh_ros.core.simulator import ContactSimulator
+
+SCENE = {
+    "contacts": ["finger"],
+    "finger.indenter.shape": "sphere",
+    "finger.indenter.radius": 0.01,
+    "finger.material.glass_shear_modulus": 1.0e6,
+    "finger.material.kelvin_shear_moduli": [2.0e5],
+    "finger.material.kelvin_viscosities": [2.0e3],
+    "finger.adhesion.work_of_adhesion": 0.05,
+    "finger.numerics.preset": "fast",
+    "finger.numerics.model": "time_stepped",
+}
+
+
+def _twins(**extra: Any) -> tuple[ContactSimulator, ContactSimulator]:
+    contact = SceneConfig.from_parameters({**SCENE, **extra}).contact("finger")
+    return ContactSimulator(contact), ContactSimulator(contact)
+
+
+def _pressed(sim: ContactSimulator) -> None:
+    """A short loading history: the contact is in touch and its memory is loaded."""
+    for k, depth in enumerate([-1e-6, 5e-6, 1.2e-5, 2.0e-5]):
+        sim.step(0.01 * k, depth=depth)
+
+
+def _assert_same(live: ContactSimulator, twin: ContactSimulator, what: str) -> None:
+    assert live.time == twin.time and live.output == twin.output, what
+    after_live = live.step(live.time + 0.01, depth=2.0e-5)
+    after_twin = twin.step(twin.time + 0.01, depth=2.0e-5)
+    assert after_live == after_twin, f"{what}: next good command differs: {after_live} vs {after_twin}"
+    # And the hidden memory too: a hold lets it speak.
+    assert live.advance(live.time + 0.5) == twin.advance(twin.time + 0.5), f"{what}: memory differs"
+
+
+def test_a_depth_beyond_the_domain_is_refused_with_the_limit_and_changes_nothing() -> None:
+    live, twin = _twins()
+    _pressed(live)
+    _pressed(twin)
+    with pytest.raises(InputError) as refused:
+        live.step(live.time + 0.01, depth=1e10)
+    reason = str(refused.value)
+    assert "domain" in reason and "depth of about" in reason, reason
+    _assert_same(live, twin, "depth 1e10 m")
+    np.testing.assert_allclose(live.output.force, twin.output.force, rtol=0, atol=0)
+    assert live.output.force > 1e-3, "a 20 um press on this sphere pushes with about 2 mN"
+
+
+@pytest.mark.parametrize(
+    "bad",
+    [
+        lambda s: s.step(s.time - 0.001, depth=1e-5),
+        lambda s: s.step(s.time + 0.01, depth=float("nan")),
+        lambda s: s.step(s.time + 0.01, force=1e12),
+        lambda s: s.step_depths(np.array([s.time + 0.01, s.time + 0.02]), np.array([2.5e-5, 1e10])),
+    ],
+    ids=["time-backwards", "nan-depth", "unreachable-force", "step_depths-bad-last-row"],
+)
+def test_every_refused_step_leaves_the_state_bit_identical(bad: Callable[[ContactSimulator], Any]) -> None:
+    live, twin = _twins()
+    _pressed(live)
+    _pressed(twin)
+    with pytest.raises(InputError):
+        bad(live)
+    _assert_same(live, twin, "refused step")
+
+
+def test_an_exception_inside_the_model_restores_the_state(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Whatever goes wrong mid-step (here: after the model advanced), nothing is half-applied."""
+    live, twin = _twins()
+    _pressed(live)
+    _pressed(twin)
+    real = live._model.advance
+
+    def advance_then_fail(*args: Any) -> Any:
+        real(*args)
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(live._model, "advance", advance_then_fail)
+    with pytest.raises(KeyboardInterrupt):
+        live.step(live.time + 0.01, depth=3e-5)
+    with pytest.raises(KeyboardInterrupt):
+        live.advance(live.time + 0.2)
+    monkeypatch.undo()
+    _assert_same(live, twin, "interrupted step")

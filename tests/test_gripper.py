@@ -1,0 +1,161 @@
+"""The MuJoCo gripper cell (viscoadh_ros.gripper): coupling, stability, picks, the two paths.
+
+Model paths: the built-in cell's pad has a Kelvin element, so "auto" runs the time-stepped
+model; the Hertz test forces ``numerics.model: time_stepped`` on an elastic pad.
+"""
+
+from __future__ import annotations
+
+import math
+import subprocess
+import sys
+from dataclasses import replace
+
+import mujoco
+import numpy as np
+import pytest
+import yaml
+
+from viscoadh_ros.core.config import SceneConfig
+from viscoadh_ros.core.errors import ConfigError, InputError
+from viscoadh_ros.core.reference import hertz_force
+from viscoadh_ros.gripper.config import cell_from_dict, default_cell_path, load_cell
+from viscoadh_ros.gripper.cycle import run_cycle
+from viscoadh_ros.gripper.motion import Motion
+from viscoadh_ros.gripper.pads import LibraryPads, step_time
+from viscoadh_ros.gripper.scenarios import GOOD, SHORT, capacity, with_mass
+from viscoadh_ros.gripper.scene import CellModel
+
+
+@pytest.fixture(scope="module")
+def cell():
+    return load_cell(default_cell_path())
+
+
+def raw_cell():
+    return yaml.safe_load(default_cell_path().read_text())
+
+
+def test_adhesion_off_pad_resting_on_a_part_settles_at_the_hertz_depth():
+    data = raw_cell()
+    pad = data["/**"]["ros__parameters"]["pad"]
+    pad["material"] = {"glass_shear_modulus": 3.0e5, "poisson_ratio": 0.5}
+    pad["adhesion"] = {"work_of_adhesion": 0.0}
+    pad["numerics"] = {"model": "time_stepped"}
+    # A soft servo pressing from far below: an almost constant load on the part.
+    data["gripper"]["arm"] = {"stiffness": 2.0, "damping": 40.0, "start_height": 1.0e-4}
+    cell = cell_from_dict(data)
+    world = CellModel(cell, latch_open_height=0.05)
+    pads = LibraryPads(cell.pad, 1)
+    dt_ns = round(cell.gripper.timestep * 1e9)
+    m, d = world.model, world.data
+    depths = []
+    for step in range(2500):
+        mujoco.mj_step1(m, d)
+        geometry = world.pad_geometry()
+        states = pads.step(step_time(step, dt_ns), geometry.depth)
+        world.apply_pad_forces(geometry, states.force)
+        world.set_controls(-0.05, latch_closed=False)
+        mujoco.mj_step2(m, d)
+        depths.append(geometry.depth[0])
+    load = float(d.actuator_force[world.arm_actuator])  # the servo's push = what the pad carries
+    e_star = 4.0 * 3.0e5
+    radius = float(cell.pad.indenter.radius)
+    expected = (3.0 * abs(load) / (4.0 * e_star * math.sqrt(radius))) ** (2.0 / 3.0)
+    assert pads.simulators[0].model == "time_stepped"
+    np.testing.assert_allclose(depths[-1], expected, rtol=0.01, err_msg="resting pad depth vs Hertz")
+    np.testing.assert_allclose(float(hertz_force(depths[-1], radius, e_star)), abs(load), rtol=0.03)
+    swing = np.ptp(depths[-500:])
+    assert swing < 0.01 * expected, f"the resting pad still swings by {swing:.3g} m"
+
+
+def test_a_lifted_part_hangs_without_a_growing_oscillation(cell):
+    tr = run_cycle(cell, replace(GOOD, carry_time=0.6), LibraryPads(cell.pad, 1))
+    assert tr.success, tr.outcome
+    carry = tr.force[tr.segment == "carry", 0]
+    first, last = np.ptp(carry[:500]), np.ptp(carry[-500:])
+    assert last <= first, f"oscillation grew in the carry: {first:.3g} N -> {last:.3g} N"
+    np.testing.assert_allclose(carry[-500:].mean(), -tr.part_mass * 9.81, rtol=0.05)
+
+
+def test_lighter_than_predicted_is_lifted_and_heavier_stays(cell):
+    limit = capacity(cell, GOOD)
+    light = run_cycle(with_mass(cell, 0.6 * limit), GOOD, LibraryPads(cell.pad, 1))
+    heavy = run_cycle(with_mass(cell, 1.4 * limit), GOOD, LibraryPads(cell.pad, 1))
+    assert light.success and light.pick_step is not None, light.outcome
+    assert not heavy.success and heavy.pick_step is None, heavy.outcome
+
+
+def test_a_pad_out_of_contact_exerts_exactly_zero_force(cell):
+    tr = run_cycle(cell, SHORT, LibraryPads(cell.pad, 1), stop_after_release=True)
+    apart = (tr.contact_radius[:, 0] == 0.0) & (tr.depth[:, 0] < 0.0)
+    assert apart.sum() > 100
+    assert np.all(tr.force[apart, 0] == 0.0)
+    world = CellModel(cell, latch_open_height=0.05)
+    mujoco.mj_step1(world.model, world.data)
+    world.data.qfrc_applied[:] = 1.0
+    world.apply_pad_forces(world.pad_geometry(), np.zeros(1))
+    assert np.all(world.data.qfrc_applied == 0.0)
+
+
+def test_library_and_node_paths_release_at_the_same_step(cell, ros_context):
+    from viscoadh_ros.gripper.node_loop import NodePads
+
+    motion = replace(SHORT, approach_speed=0.02)
+    library = run_cycle(cell, motion, LibraryPads(cell.pad, 1), stop_after_release=True)
+    with NodePads(cell) as bank:
+        node = run_cycle(cell, motion, bank, stop_after_release=True)
+    assert library.release_step is not None
+    assert node.release_step == library.release_step
+    np.testing.assert_array_equal(node.force, library.force)
+    np.testing.assert_array_equal(node.part_rise, library.part_rise)
+
+
+def test_a_time_step_too_long_for_the_part_is_refused(cell):
+    light = with_mass(cell, 0.2e-3)
+    with pytest.raises(InputError, match=r"gripper.timestep .* too long .*\(use gripper.timestep <="):
+        run_cycle(light, GOOD, LibraryPads(cell.pad, 1))
+
+
+@pytest.mark.parametrize(
+    ("section", "value", "message"),
+    [
+        ("arm", {"stifness": 1.0}, r"gripper.arm.stifness: unknown key \(did you mean 'stiffness'\?\)"),
+        ("part", {"mass": -1.0}, r"gripper.part.mass must be a finite number > 0"),
+        ("pads", {"rows": 0}, r"gripper.pads.rows must be an integer from 1 to 8"),
+        ("part", {"size": [0.01, 0.01, 0.005]}, r"gripper.part.size: the part .* is too small"),
+    ],
+)
+def test_a_bad_gripper_key_is_one_clear_error(section, value, message):
+    data = raw_cell()
+    data["gripper"][section] = value
+    with pytest.raises(ConfigError, match=message):
+        cell_from_dict(data)
+
+
+def test_pad_scene_has_one_contact_per_pad(cell):
+    many = replace(cell, gripper=cell.gripper.with_pads(2, 2))
+    scene = many.pad_scene()
+    assert scene.ids == ("pad_0", "pad_1", "pad_2", "pad_3")
+    assert SceneConfig.from_dict(scene.to_dict()).contacts[3].material == cell.pad.material
+
+
+def test_cli_bad_cell_is_one_line_and_exit_2(tmp_path):
+    bad = tmp_path / "cell.yaml"
+    text = default_cell_path().read_text().replace("stiffness: 2.0e+4", "stifness: 2.0e+4")
+    bad.write_text(text)
+    result = subprocess.run(
+        [sys.executable, "-m", "viscoadh_ros", "gripper", "--cell", str(bad), "--out", str(tmp_path)],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    assert result.returncode == 2
+    assert result.stderr.strip().splitlines() == [
+        "viscoadh gripper: error: gripper.arm.stifness: unknown key (did you mean 'stiffness'?)"
+    ]
+
+
+def test_motion_rejects_a_negative_hold():
+    with pytest.raises(InputError, match="hold_time must be a finite number >= 0"):
+        Motion(hold_time=-1.0).validated()

@@ -1,0 +1,262 @@
+"""The node under faults, in-process (issue 11): a client node publishes as a controller would.
+
+Each rejected command must leave the contact exactly as a twin simulator fed only the good
+commands, say why on ``C/events`` (and in the MCAP log), and never lock the contact out. A new
+or reset contact stays out of touch until a command brings it in.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+import yaml
+from diagnostic_msgs.msg import DiagnosticArray
+from mcap.reader import make_reader
+from rclpy.parameter import Parameter
+from rclpy.qos import qos_profile_sensor_data
+from std_srvs.srv import Trigger
+from test_node_live import SCENE, TIMEOUT, Client, _command
+from viscoadh_msgs.msg import ContactEvent, ContactState, IndentationCommand
+
+from viscoadh_ros.core.config import SceneConfig
+from viscoadh_ros.core.simulator import ContactSimulator
+from viscoadh_ros.io.bag import Bag
+from viscoadh_ros.ros.node import ViscoadhNode
+
+#: The test_node_live scene with the default tolerance for stamps ahead of the clock (1 s).
+FAULT_SCENE = {k: v for k, v in SCENE.items() if k != "command.max_future_s"}
+
+
+def _node(context: Any, executor: Any, scene: dict[str, Any] = FAULT_SCENE, **kwargs: Any) -> ViscoadhNode:
+    overrides = [Parameter(name, value=value) for name, value in scene.items()]
+    node = ViscoadhNode(context=context, parameter_overrides=overrides, **kwargs)
+    executor.add_node(node)
+    return node
+
+
+class EventClient(Client):
+    """A client that also listens to the contact's events (as a late joiner would)."""
+
+    def __init__(
+        self, *args: Any, contact: str = "elastic", ahead_ns: int = 300_000_000, **kwargs: Any
+    ) -> None:
+        super().__init__(*args, contact=contact, **kwargs)
+        self.events: list[ContactEvent] = []
+        self.node.create_subscription(ContactEvent, f"{contact}/events", self.events.append, 50)
+        # Stamps ahead of the clock (by default within the default tolerance of 1 s): the hold
+        # timer advances a contact only up to now.
+        self.t0 = self.node.get_clock().now().nanoseconds + ahead_ns
+
+    def rejected(self, index: int) -> ContactEvent:
+        """Wait for the COMMAND_REJECTED event of command ``index``."""
+
+        def event() -> ContactEvent | None:
+            return next((e for e in self.events if e.command_index == index and e.kind == 1), None)
+
+        assert self.spin_until(self.executor, lambda: event() is not None, TIMEOUT), f"no event {index}"
+        return event()
+
+
+def _twin(contact: str, scene: dict[str, Any] = FAULT_SCENE) -> ContactSimulator:
+    return ContactSimulator(SceneConfig.from_parameters(scene).contact(contact))
+
+
+@pytest.mark.parametrize(
+    "future_ns, what",
+    [(3600 * 10**9, "+1 h"), (None, "2038")],
+)
+def test_a_command_stamped_far_ahead_is_rejected_and_does_not_lock_the_contact(
+    ros_context: Any, ros_executor: Any, spin_until: Any, future_ns: int | None, what: str
+) -> None:
+    node = _node(ros_context, ros_executor)
+    client = EventClient(ros_context, ros_executor, spin_until)
+    assert client.send(_command(client.t0, depth=5e-6)) is not None
+    far = (2**31 - 1) * 10**9 if future_ns is None else node.now_ns() + future_ns
+    assert client.send(_command(far, depth=8e-6), expect_state=False) is None, what
+    event = client.rejected(1)
+    assert "ahead of the node clock" in event.reason and "command.max_future_s" in event.reason, event.reason
+    after = client.send(_command(client.t0 + 10_000_000, depth=6e-6))
+    assert after is not None, f"{what}: a normal command after the far one must be accepted"
+    twin = _twin("elastic")
+    twin.step(0.0, depth=5e-6)
+    expected = twin.step(0.01, depth=6e-6)
+    assert after.force == pytest.approx(expected.force, rel=1e-12), what
+    assert (after.commands_received, after.commands_rejected) == (2, 1)
+
+
+def test_the_future_tolerance_changes_at_runtime(
+    ros_context: Any, ros_executor: Any, spin_until: Any
+) -> None:
+    node = _node(ros_context, ros_executor)
+    client = EventClient(ros_context, ros_executor, spin_until)
+    ahead = node.now_ns() + 3 * 10**9
+    assert client.send(_command(ahead, depth=1e-6), expect_state=False) is None, "3 s ahead > 1 s"
+    assert node.set_parameters([Parameter("command.max_future_s", value=10.0)])[0].successful
+    assert client.send(_command(ahead, depth=1e-6)) is not None, "3 s ahead <= 10 s"
+
+
+@pytest.mark.parametrize(
+    "sec, nanosec", [(-(2**31), 0), (-1, 999_999_999), (5, 1_000_000_000), (5, 2**32 - 1)]
+)
+def test_a_malformed_stamp_is_rejected(
+    ros_context: Any, ros_executor: Any, spin_until: Any, sec: int, nanosec: int
+) -> None:
+    _node(ros_context, ros_executor)
+    client = EventClient(ros_context, ros_executor, spin_until)
+    msg = IndentationCommand(mode=IndentationCommand.DEPTH, depth=1e-6)
+    msg.header.stamp.sec, msg.header.stamp.nanosec = sec, nanosec
+    assert client.send(msg, expect_state=False) is None
+    assert "sec >= 0 and nanosec < 1000000000" in client.rejected(0).reason
+    assert client.send(_command(client.t0, depth=1e-6)) is not None, "the contact is not locked"
+
+
+def test_a_refused_huge_depth_leaves_the_contact_as_its_twin(
+    ros_context: Any, ros_executor: Any, spin_until: Any
+) -> None:
+    """Time-stepped contact (a standard solid): 1e10 m cannot be represented by its domain.
+    Stamps 10 s ahead, so the hold timer never relaxes it between the commands."""
+    _node(ros_context, ros_executor, {**FAULT_SCENE, "command.max_future_s": 30.0})
+    client = EventClient(ros_context, ros_executor, spin_until, contact="visco", ahead_ns=10 * 10**9)
+    twin = _twin("visco")
+    depths = [5e-6, 1.2e-5, 2e-5]
+    for k, depth in enumerate(depths):
+        client.send(_command(client.t0 + k * 10_000_000, depth=depth))
+        twin.step(k * 0.01, depth=depth)
+    assert client.send(_command(client.t0 + 30_000_000, depth=1e10), expect_state=False) is None
+    reason = client.rejected(3).reason
+    assert "domain" in reason and "depth of about" in reason, reason
+    after = client.send(_command(client.t0 + 40_000_000, depth=2e-5))
+    expected = twin.step(0.04, depth=2e-5)
+    assert after.force == expected.force and after.phase == int(expected.phase), (
+        f"{after.force} N after the refused command, the twin {expected.force} N"
+    )
+    assert after.force > 1e-3, "a 20 um press pushes with about 2 mN"
+
+
+def test_new_and_reset_contacts_stay_out_of_touch_and_take_parameters(
+    ros_context: Any, ros_executor: Any, spin_until: Any
+) -> None:
+    """Depth 0 touches the surface, but no command yet is no contact: the hold timer (here
+    100 Hz; the idle heartbeat comes once per second) must not bring the contact in."""
+    node = _node(ros_context, ros_executor, {**FAULT_SCENE, "publish_rate": 100.0})
+    client = EventClient(ros_context, ros_executor, spin_until)
+
+    def quiet_for(seconds: float) -> list[ContactState]:
+        start = len(client.states)
+        deadline = time.monotonic() + seconds
+        spin_until(ros_executor, lambda: time.monotonic() > deadline, seconds + 1.0)
+        return client.states[start:]
+
+    heartbeats = quiet_for(1.5)
+    assert heartbeats, "an idle contact still publishes its heartbeat"
+    assert all(s.phase == ContactState.NO_CONTACT and s.force == 0.0 for s in heartbeats), [
+        (s.phase, s.force) for s in heartbeats
+    ]
+    assert len(heartbeats) <= 3, f"an idle contact publishes once per second, not {len(heartbeats)}"
+    softer = Parameter("elastic.material.glass_shear_modulus", value=5.0e5)
+    assert node.set_parameters([softer])[0].successful, "parameters change on a new contact"
+
+    assert client.send(_command(client.t0, depth=5e-6)).phase != ContactState.NO_CONTACT
+    assert client.call(client.reset, Trigger.Request()).success
+    after_reset = quiet_for(1.5)
+    assert all(s.phase == ContactState.NO_CONTACT and s.force == 0.0 for s in after_reset), [
+        (s.phase, s.force) for s in after_reset
+    ]
+    stiffer = Parameter("elastic.material.glass_shear_modulus", value=2.0e6)
+    result = node.set_parameters([stiffer])[0]
+    assert result.successful, f"parameters change after a reset: {result.reason}"
+
+
+def test_diagnostics_of_two_namespaced_nodes_are_told_apart(
+    ros_context: Any, ros_executor: Any, spin_until: Any
+) -> None:
+    from rclpy.node import Node
+
+    _node(ros_context, ros_executor, namespace="left")
+    _node(ros_context, ros_executor, namespace="right")
+    probe = Node("probe", context=ros_context)
+    ros_executor.add_node(probe)
+    names: set[str] = set()
+    probe.create_subscription(
+        DiagnosticArray, "/diagnostics", lambda a: names.update(s.name for s in a.status), 10
+    )
+    expected = {f"/{ns}/viscoadh: {c}" for ns in ("left", "right") for c in ("elastic", "visco")}
+    assert spin_until(ros_executor, lambda: expected <= names, 4.0), names
+
+
+def test_a_best_effort_command_publisher_is_warned_about_naming_the_qos(
+    ros_context: Any, ros_executor: Any, spin_until: Any, capfd: pytest.CaptureFixture[str]
+) -> None:
+    """Documented choice: commands are reliable; a sensor-data publisher gets a warning."""
+    from rclpy.node import Node
+
+    node = _node(ros_context, ros_executor)
+    controller = Node("sensor_data_controller", context=ros_context)
+    ros_executor.add_node(controller)
+    controller.create_publisher(IndentationCommand, "elastic/indentation", qos_profile_sensor_data)
+    counters = node.contacts["elastic"].counters
+    assert spin_until(ros_executor, lambda: counters.incompatible_publishers == 1, 3.0), (
+        "the incompatible publisher was not noticed"
+    )
+    assert "RELIABILITY" in counters.last_rejection, counters.last_rejection
+    assert "RELIABILITY" in capfd.readouterr().err, "the warning must be logged"
+
+
+def test_events_log_every_rejection_reset_and_parameter_change_in_order(
+    ros_context: Any, ros_executor: Any, spin_until: Any, tmp_path: Path
+) -> None:
+    log = tmp_path / "run.mcap"
+    node = _node(ros_context, ros_executor, {**FAULT_SCENE, "log.enabled": True, "log.path": str(log)})
+    client = EventClient(ros_context, ros_executor, spin_until)
+    t0 = client.t0
+    client.send(_command(t0, depth=5e-6))
+    bad = _command(t0 + 10_000_000, depth=math.nan)
+    client.send(bad, expect_state=False)
+    client.send(_command(t0 + 20_000_000, depth=4e-6))
+    client.send(_command(t0 + 30_000_000, depth=1e-6, mode=7), expect_state=False)
+    nan_event, mode_event = client.rejected(1), client.rejected(3)
+    assert nan_event.command_stamp == bad.header.stamp and "depth must be finite" in nan_event.reason
+    assert "mode" in mode_event.reason and mode_event.contact_id == "elastic"
+    assert client.call(client.reset, Trigger.Request()).success
+    changed = Parameter("elastic.adhesion.work_of_adhesion", value=0.2)
+    assert node.set_parameters([changed])[0].successful
+    client.send(_command(t0 + 40_000_000, depth=5e-6))
+    assert spin_until(ros_executor, lambda: len(client.events) == 4, TIMEOUT), client.events
+    kinds = [e.kind for e in client.events]
+    assert kinds == [ContactEvent.COMMAND_REJECTED] * 2 + [ContactEvent.RESET, ContactEvent.PARAMETERS]
+    stored = SceneConfig.from_dict(yaml.safe_load(client.events[-1].contact_yaml))
+    assert stored.contacts == (SceneConfig.from_parameters(node.scene.to_parameters()).contact("elastic"),)
+    assert stored.contacts[0].adhesion.work_of_adhesion == 0.2
+
+    ros_executor.remove_node(node)
+    node.destroy_node()
+    with open(log, "rb") as stream:
+        summary = make_reader(stream).get_summary()
+    schema = next(s for s in summary.schemas.values() if s.name == "viscoadh_msgs/msg/ContactEvent")
+    assert "MSG: builtin_interfaces/Time" in schema.data.decode(), "the schema carries its dependencies"
+    channel = next(c for c in summary.channels.values() if c.topic == "/elastic/events")
+    assert yaml.safe_load(channel.metadata["offered_qos_profiles"])[0]["durability"] == "transient_local"
+    bag = Bag(log)
+    sequence = [
+        (m.topic, getattr(m.msg, "kind", None))
+        for m in bag.messages(["/elastic/indentation", "/elastic/events"])
+    ]
+    assert sequence == [
+        ("/elastic/indentation", None),
+        ("/elastic/indentation", None),
+        ("/elastic/events", ContactEvent.COMMAND_REJECTED),
+        ("/elastic/indentation", None),
+        ("/elastic/indentation", None),
+        ("/elastic/events", ContactEvent.COMMAND_REJECTED),
+        ("/elastic/events", ContactEvent.RESET),
+        ("/elastic/events", ContactEvent.PARAMETERS),
+        ("/elastic/indentation", None),
+    ], "the log keeps every command and event in the order they took effect"
+    forces = [m.msg.force for m in bag.messages(["/elastic/state"]) if m.msg.commands_received == 3]
+    expected = ContactSimulator(stored.contacts[0]).step(0.0, depth=5e-6).force
+    np.testing.assert_allclose(forces[-1], expected, rtol=1e-12, err_msg="after the change")

@@ -1,0 +1,194 @@
+"""The scenarios of `viscoadh gripper`, each a few runs of `run_cycle` and one figure.
+
+- ``pick``: a press too short (no hold) and one too shallow fail, a press held long enough
+  lifts the part.
+- ``transport``: the same grip lifted gently and with a hard acceleration (the pads carry
+  ``m (g + a)`` while it lasts).
+- ``place``: pick, carry, lower into the fixture, latch (a weak and a strong one), retract:
+  the release succeeds only if the pads' pull-off stays below the latch's holding force plus
+  the part's weight.
+- ``controller``: `plan_pick` chooses press depth and hold time from `predict_pull_off` so the
+  pick holds with a safety factor; at the latch `choose_release_speed` asks the live pads for
+  the retract speed whose pull-off the fixture can hold.
+- ``weights``: parts of several masses for two grips, against the model's predicted capacity.
+
+`Bank` is a factory ``cell -> PadBank`` (library or node path); each run gets a fresh bank.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from viscoadh_ros.core.history import predict_pull_off
+from viscoadh_ros.core.simulator import ContactSimulator
+
+from .config import Cell
+from .cycle import GRAVITY, Trajectory, run_cycle
+from .motion import Motion
+from .pads import LibraryPads, PadBank
+
+SCENARIOS = ("pick", "transport", "place", "controller", "weights")
+#: The controller's safety factor on the pick (pull-off against m (g + a)) and the release.
+SAFETY_FACTOR = 1.5
+#: Retract speeds the controller may release at, m/s (slowest first: the gentlest that works).
+RELEASE_SPEEDS = (0.002, 0.01, 0.05, 0.2)
+
+Bank = Callable[[Cell], PadBank]
+
+
+def library_bank(cell: Cell) -> PadBank:
+    """The fast path: the pads' simulators in this process."""
+    return LibraryPads(cell.pad, cell.gripper.pad_count)
+
+
+def with_mass(cell: Cell, mass: float) -> Cell:
+    return replace(cell, gripper=cell.gripper.with_part_mass(mass))
+
+
+@dataclass(frozen=True)
+class Run:
+    """One labelled run of a scenario."""
+
+    label: str
+    trajectory: Trajectory
+
+
+def _run(label: str, cell: Cell, motion: Motion, bank: Bank, **kwargs) -> Run:
+    pads = bank(cell)
+    try:
+        return Run(label, run_cycle(cell, motion, pads, **kwargs))
+    finally:
+        pads.close()
+
+
+def predicted_pull_off(cell: Cell, motion: Motion) -> float:
+    """Total pull-off force of the pads (N, < 0) the model predicts for ``motion``'s press:
+    one pad pressed at the approach speed from the start height to ``press_depth`` into a
+    rigid part, held ``hold_time``, then asked `predict_pull_off` at ``lift_speed``, times
+    the number of pads. (The servo gets slightly less deep than its reference: the safety
+    factor covers it.)"""
+    simulator = ContactSimulator(cell.pad)
+    start = cell.gripper.arm.start_height
+    approach = (start + motion.press_depth) / motion.approach_speed
+    samples = max(2, int(approach / cell.gripper.timestep) + 1)
+    times = np.linspace(0.0, approach, samples)
+    simulator.step_depths(times, -start + motion.approach_speed * times)
+    if motion.hold_time > 0.0:
+        simulator.step(approach + motion.hold_time, depth=motion.press_depth)
+    single = predict_pull_off(simulator, motion.lift_speed).pull_off_force
+    return cell.gripper.pad_count * single
+
+
+def capacity(cell: Cell, motion: Motion) -> float:
+    """Heaviest part (kg) the predicted pull-off lifts at the motion's lift acceleration."""
+    return -predicted_pull_off(cell, motion) / (GRAVITY + motion.lift_acceleration)
+
+
+def plan_pick(cell: Cell, base: Motion, *, safety: float = SAFETY_FACTOR) -> Motion:
+    """The quickest press (shallowest, then shortest hold) of a small grid whose predicted
+    pull-off carries ``safety`` times ``m (g + a)``; ValueError if none does."""
+    need = safety * cell.gripper.part.mass * (GRAVITY + base.lift_acceleration)
+    for hold in (0.0, 0.1, 0.2, 0.4, 0.8):
+        for depth in (20e-6, 50e-6, 100e-6, 150e-6):
+            motion = replace(base, press_depth=depth, hold_time=hold)
+            if -predicted_pull_off(cell, motion) >= need:
+                return motion
+    raise ValueError(
+        f"no press of the grid holds a {cell.gripper.part.mass * 1e3:g} g part with safety {safety:g}"
+    )
+
+
+def choose_release_speed(cell: Cell, bank: PadBank, *, safety: float = SAFETY_FACTOR) -> tuple[float, dict]:
+    """At the latch: the slowest of RELEASE_SPEEDS whose predicted total pull-off, times
+    ``safety``, stays below the holding force plus the part's weight (else the fastest).
+    Returns (speed m/s, {speed: predicted total pull-off N})."""
+    hold = cell.gripper.fixture.holding_force + cell.gripper.part.mass * GRAVITY
+    predictions = {v: float(bank.predict_pull_off(v).sum()) for v in RELEASE_SPEEDS}
+    for speed in RELEASE_SPEEDS:
+        if -predictions[speed] * safety <= hold:
+            return speed, predictions
+    return RELEASE_SPEEDS[-1], predictions
+
+
+#: The scenarios' grips: a good press and two that fail (base part 1 g, built-in cell).
+GOOD = Motion(press_depth=150e-6, hold_time=0.3)
+SHORT = replace(GOOD, hold_time=0.0)
+SHALLOW = replace(GOOD, press_depth=10e-6)
+
+
+def scenario_pick(cell: Cell, bank: Bank) -> list[Run]:
+    return [
+        _run("press 150 um, no hold (too short)", cell, SHORT, bank),
+        _run("press 10 um, hold 0.3 s (too shallow)", cell, SHALLOW, bank),
+        _run("press 150 um, hold 0.3 s", cell, GOOD, bank),
+    ]
+
+
+def scenario_transport(cell: Cell, bank: Bank) -> list[Run]:
+    gentle = replace(GOOD, lift_acceleration=2.0, lift_height=0.02, carry_time=0.3)
+    hard = replace(gentle, lift_acceleration=40.0, lift_speed=0.2)
+    return [
+        _run("lift at 2 m/s^2", cell, gentle, bank),
+        _run("lift at 40 m/s^2", cell, hard, bank),
+    ]
+
+
+def with_holding_force(cell: Cell, force: float) -> Cell:
+    fixture = replace(cell.gripper.fixture, holding_force=force)
+    return replace(cell, gripper=replace(cell.gripper, fixture=fixture))
+
+
+def scenario_place(cell: Cell, bank: Bank) -> list[Run]:
+    place = replace(GOOD, place=True, retract_speed=0.002)
+    return [
+        _run("latch holds 2 mN", with_holding_force(cell, 0.002), place, bank),
+        _run("latch holds 20 mN", with_holding_force(cell, 0.02), place, bank),
+    ]
+
+
+def scenario_controller(cell: Cell, bank: Bank) -> list[Run]:
+    motion = replace(plan_pick(cell, Motion(place=True, retract_speed=None)), place=True, retract_speed=None)
+    asked: dict = {}
+
+    def decide(pads: PadBank) -> float:
+        speed, predictions = choose_release_speed(cell, pads)
+        asked.update(predictions)
+        return speed
+
+    run = _run(
+        f"planned: press {motion.press_depth * 1e6:g} um, hold {motion.hold_time:g} s",
+        cell,
+        motion,
+        bank,
+        choose_retract_speed=decide,
+    )
+    run.trajectory.predictions["pick_pull_off"] = predicted_pull_off(cell, motion)
+    for speed, force in asked.items():
+        run.trajectory.predictions[f"release_pull_off@{speed:g}"] = force
+    return [run]
+
+
+#: Part masses of the weights scenario, kg.
+WEIGHTS = (0.5e-3, 0.8e-3, 1.1e-3, 1.4e-3, 1.7e-3)
+
+
+def scenario_weights(cell: Cell, bank: Bank) -> list[Run]:
+    runs = []
+    for label, motion in (("no hold", SHORT), ("hold 0.3 s", GOOD)):
+        for mass in WEIGHTS:
+            run = _run(f"{label}|{mass * 1e3:g} g", with_mass(cell, mass), motion, bank)
+            run.trajectory.predictions["capacity_kg"] = capacity(with_mass(cell, mass), motion)
+            runs.append(run)
+    return runs
+
+
+RUNNERS: dict[str, Callable[[Cell, Bank], list[Run]]] = {
+    "pick": scenario_pick,
+    "transport": scenario_transport,
+    "place": scenario_place,
+    "controller": scenario_controller,
+    "weights": scenario_weights,
+}
