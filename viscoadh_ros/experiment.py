@@ -11,9 +11,23 @@ Inputs (the control): ``viscoadh_msgs/msg/IndentationCommand`` (DEPTH or FORCE m
 (``wrench.force.z``, N) or ``std_msgs/msg/Float64`` (N), taken as the model's sign
 (> 0 compressive, pushing the indenter out; this is what the node publishes); ``flip_force``
 negates it for load cells that read tension positive. Times: ``header.stamp`` when the message
-has one (a zero stamp means "on receipt"), else the log time. Events of equal time run in the
-order they were recorded: a node log holds a hold-timer state stamped at a command's stamp
-before that command (the timer ran first) and the command's answer after it.
+has one (a zero stamp means "on receipt"), else the log time.
+
+Two orders of events:
+
+- A **node log** (IndentationCommand inputs in a file written by viscoadh's recorder, which
+  stores the software version, or in any recording that holds the contact's ``C/events``)
+  runs in recording order, which is the order the node
+  handled things in: it logs each command on receipt, before its answer, and its hold-timer
+  states as it publishes them. The node's verdicts are applied as the node made them: a
+  command refused by the node (a ``COMMAND_REJECTED`` ``ContactEvent`` on ``C/events`` naming
+  its index among the commands received; or, in logs without events, what the node always
+  refuses: an unknown mode, a non-finite value, a stamp older than the last accepted command's)
+  is skipped; a ``RESET`` or ``PARAMETERS`` event restarts the contact at its place in the
+  log (fresh state, at rest until the next accepted command; PARAMETERS with the contact
+  configuration it carries), and the next accepted command starts a new time base, as in the
+  node.
+- Any other recording runs by stamp; at equal stamps in recording order.
 """
 
 from __future__ import annotations
@@ -21,7 +35,7 @@ from __future__ import annotations
 import math
 import time as wallclock
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -40,10 +54,23 @@ FLOAT64 = "std_msgs/msg/Float64"
 POINT = "geometry_msgs/msg/PointStamped"
 POSE = "geometry_msgs/msg/PoseStamped"
 WRENCH = "geometry_msgs/msg/WrenchStamped"
+EVENT = "viscoadh_msgs/msg/ContactEvent"
 INPUT_TYPES = (COMMAND, FLOAT64, POINT, POSE)
 FORCE_TYPES = (WRENCH, FLOAT64)
 
 DEPTH, FORCE = 0, 1  # input modes, equal to IndentationCommand.DEPTH / FORCE
+COMMAND_REJECTED, RESET, PARAMETERS = 1, 2, 3  # ContactEvent.kind
+
+
+@dataclass(frozen=True)
+class Restart:
+    """A RESET or PARAMETERS event of a node log: the contact restarts from a fresh state
+    (PARAMETERS: with ``contact_yaml``, the scene YAML holding the changed contact)."""
+
+    kind: int  # RESET or PARAMETERS
+    ns: int  # the event's stamp (node clock), ns
+    order: int  # position in the recording
+    contact_yaml: str = ""
 
 
 @dataclass(frozen=True)
@@ -51,11 +78,12 @@ class Experiment:
     """Inputs and measured force of one contact on one time base.
 
     Times are integer ns on the recording's clock; ``time(ns)`` gives seconds since ``t0_ns``
-    (the first input), which is the simulation time.
+    (the first input). The inputs are the accepted ones, in the order they run (see the module
+    docstring); ``rejected_index`` lists the commands skipped as the node refused them.
     """
 
     t0_ns: int
-    input_ns: NDArray[np.int64]  # (n,) stamps of the inputs, non-decreasing
+    input_ns: NDArray[np.int64]  # (n,) stamps of the accepted inputs, in run order
     input_order: NDArray[np.int64]  # (n,) positions of the inputs in the recording
     input_mode: NDArray[np.uint8]  # (n,) DEPTH or FORCE
     input_value: NDArray[np.float64]  # (n,) depth, m, or force, N
@@ -64,6 +92,15 @@ class Experiment:
     measured_order: NDArray[np.int64]  # (m,) positions of the force samples in the recording
     input_topic: str
     force_topic: str | None
+    #: True for a node log: events run in recording order (else by stamp).
+    by_arrival: bool = False
+    #: (n,) index of each accepted input among all inputs received (0-based).
+    input_index: NDArray[np.int64] | None = None
+    #: (r,) indexes of the commands skipped as refused by the node, and why.
+    rejected_index: NDArray[np.int64] = field(default_factory=lambda: np.empty(0, dtype=np.int64))
+    rejected_reason: tuple[str, ...] = ()
+    restarts: tuple[Restart, ...] = ()  # RESET / PARAMETERS events, in recording order
+    events_topic: str | None = None
 
     def time(self, ns: NDArray[np.int64]) -> NDArray[np.float64]:
         """Seconds since the first input."""
@@ -73,9 +110,20 @@ class Experiment:
     def duration(self) -> float:
         """Span of the record (inputs and measured force), s."""
         last = (
-            self.input_ns[-1] if self.measured_ns.size == 0 else max(self.input_ns[-1], self.measured_ns[-1])
+            int(self.input_ns.max())
+            if self.measured_ns.size == 0
+            else max(int(self.input_ns.max()), int(self.measured_ns.max()))
         )
-        return (int(last) - self.t0_ns) * 1e-9
+        return (last - self.t0_ns) * 1e-9
+
+    @property
+    def counters(self) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+        """``(commands_received, commands_rejected)`` at each accepted input, as the node's
+        ContactState counts them (accepted so far including this one; refused so far)."""
+        index = self.input_index if self.input_index is not None else np.arange(self.input_ns.size)
+        received = np.arange(1, self.input_ns.size + 1)
+        rejected = np.searchsorted(np.sort(self.rejected_index), index)
+        return received, rejected.astype(np.int64)
 
 
 #: The fields each type contributes: the input's value (and mode), or the measured force.
@@ -100,8 +148,8 @@ def _read_topic(bag: Bag, topic: str) -> tuple[NDArray[np.int64], NDArray[np.int
     :data:`_VALUE_FIELDS` of its type as arrays. Fixed-layout CDR is read in bulk; anything
     else message by message through rclpy."""
     type_name = bag.topics[topic]
-    log_ns, order, payloads = bag.raw(topic)
-    columns = cdr.decode(type_name, payloads)
+    log_ns, order, rows = bag.rows(topic)
+    columns = None if rows is None else cdr.decode(type_name, rows)
     if columns is None:
         messages = list(bag.messages([topic]))
         log_ns = np.array([m.log_time_ns for m in messages], dtype=np.int64)
@@ -120,14 +168,12 @@ def _read_topic(bag: Bag, topic: str) -> tuple[NDArray[np.int64], NDArray[np.int
     return stamps, order, columns
 
 
-def _inputs_of(topic: str, type_name: str, columns: dict[str, NDArray]) -> tuple[NDArray, NDArray]:
-    """``(mode, value)`` of every input message: DEPTH/FORCE and the depth (m) or force (N)."""
+def _inputs_of(type_name: str, columns: dict[str, NDArray]) -> tuple[NDArray, NDArray]:
+    """``(mode, value)`` of every input message: DEPTH/FORCE (or an IndentationCommand's own,
+    possibly unknown, mode) and the depth (m) or force (N)."""
     if type_name == COMMAND:
         mode = columns["mode"].astype(np.uint8)
-        bad = np.flatnonzero((mode != DEPTH) & (mode != FORCE))
-        if bad.size:
-            raise InputError(f"{topic}: IndentationCommand with unknown mode {mode[bad[0]]}")
-        return mode, np.where(mode == DEPTH, columns["depth"], columns["force"]).astype(np.float64)
+        return mode, np.where(mode == FORCE, columns["force"], columns["depth"]).astype(np.float64)
     (path,) = _VALUE_FIELDS[type_name]
     value = columns[path].astype(np.float64)
     return np.full(value.size, DEPTH, dtype=np.uint8), value
@@ -136,16 +182,26 @@ def _inputs_of(topic: str, type_name: str, columns: dict[str, NDArray]) -> tuple
 def _pick(
     bag: Bag, given: str | None, default: str | None, types: tuple[str, ...], what: str, flag: str
 ) -> str | None:
-    """The topic named by the user, else ``default`` if recorded, else the only one of ``types``."""
+    """The topic named by the user, else ``default`` (the contact's topic), which must then be
+    recorded, else the only one of ``types``; None when there is none of ``types`` (and, for
+    the force, none at all)."""
+    candidates = bag.topics_of_type(*types)
+    if FLOAT64 in types and len(types) > 1:
+        # A bare Float64 could be depth or force: never guess it.
+        candidates = [t for t in candidates if bag.topics[t] != FLOAT64]
     if given:
         topic = bag.resolve(given)
-    elif default and any(t == default or t.endswith("/" + default.strip("/")) for t in bag.topics):
+    elif default:
+        # The contact's own topic, or nothing: never another contact's (no silent fallback).
+        if not any(t == default or t.endswith("/" + default.strip("/")) for t in bag.topics):
+            if not candidates and what == "force":
+                return None
+            raise InputError(
+                f"no topic {default!r} in {str(bag.path)!r} ({what} topics found: {candidates}); "
+                f"check --contact or name the topic with {flag}"
+            )
         topic = bag.resolve(default)
     else:
-        candidates = bag.topics_of_type(*types)
-        if FLOAT64 in types and len(types) > 1:
-            # A bare Float64 could be depth or force: never guess it.
-            candidates = [t for t in candidates if bag.topics[t] != FLOAT64]
         if len(candidates) != 1:
             if not candidates:
                 return None
@@ -171,9 +227,12 @@ def load_experiment(
     """Read the inputs and the measured force of one contact from ``bag``.
 
     Without explicit topics: ``<contact>/indentation`` and ``<contact>/wrench`` when ``contact``
-    is given and recorded, else the only input topic (IndentationCommand, PointStamped,
-    PoseStamped) and the only WrenchStamped topic. A Float64 topic is used only when named.
-    Raises InputError naming what is missing, ambiguous or of the wrong type.
+    is given (an error naming the recorded topics when absent: never another contact's), else
+    the only input topic (IndentationCommand, PointStamped, PoseStamped) and the only
+    WrenchStamped topic. A Float64 topic is used only when named. In a node log, the events of
+    the input's contact (``<namespace>/events`` beside ``<namespace>/indentation``) are read
+    too (see the module docstring). Raises InputError naming what is missing, ambiguous, of
+    the wrong type or inconsistent.
     """
     inputs = _pick(
         bag,
@@ -196,12 +255,32 @@ def load_experiment(
     stamps, order, columns = _read_topic(bag, inputs)
     if stamps.size == 0:
         raise InputError(f"input topic {inputs!r} has no messages")
-    mode, value = _inputs_of(inputs, bag.topics[inputs], columns)
-    # By stamp; at equal stamps in recording order (see the module docstring).
-    by_time = np.lexsort((order, stamps))
-    input_ns, input_order, mode, value = stamps[by_time], order[by_time], mode[by_time], value[by_time]
-    if not np.all(np.isfinite(value)):
-        raise InputError(f"input topic {inputs!r} holds non-finite values")
+    mode, value = _inputs_of(bag.topics[inputs], columns)
+    # A node's log: written by our recorder, or holding the contact's events.
+    by_arrival = bag.topics[inputs] == COMMAND and (
+        bag.software_version is not None or _events_topic(inputs) in bag.topics
+    )
+    events_topic, restarts = None, ()
+    if by_arrival:
+        events_topic, restarts, refused = _node_events(bag, inputs, stamps, order, columns)
+        keep, index, rejected, reasons = _node_verdicts(stamps, order, mode, value, refused, restarts)
+        if not keep.any():
+            raise InputError(f"input topic {inputs!r}: the node refused every command ({reasons[0]})")
+        # Recording order is the order the node handled them in.
+        run = np.argsort(order, kind="stable")
+        run = run[keep[run]]
+        index = index[run]
+    else:
+        bad = np.flatnonzero((mode != DEPTH) & (mode != FORCE))
+        if bad.size:
+            raise InputError(f"{inputs}: IndentationCommand with unknown mode {mode[bad[0]]}")
+        if not np.all(np.isfinite(value)):
+            raise InputError(f"input topic {inputs!r} holds non-finite values")
+        # By stamp; at equal stamps in recording order (see the module docstring).
+        run = np.lexsort((order, stamps))
+        index = np.arange(run.size)
+        rejected, reasons = np.empty(0, dtype=np.int64), ()
+    input_ns, input_order, mode, value = stamps[run], order[run], mode[run], value[run]
     if forces:
         measured_ns, measured_order, columns = _read_topic(bag, forces)
         (path,) = _VALUE_FIELDS[bag.topics[forces]]
@@ -212,7 +291,10 @@ def load_experiment(
         measured_ns = measured_order = np.empty(0, dtype=np.int64)
         force = np.empty(0)
     # Measured samples before the first input have no model to compare with.
-    keep = measured_ns >= input_ns[0]
+    if by_arrival:
+        keep = measured_order > input_order[0]
+    else:
+        keep = measured_ns >= input_ns[0]
     if forces and not np.any(keep):
         raise InputError(
             f"empty time range: force topic {forces!r} ends before input topic {inputs!r} starts"
@@ -231,6 +313,107 @@ def load_experiment(
         measured_order=measured_order[keep],
         input_topic=inputs,
         force_topic=forces,
+        by_arrival=by_arrival,
+        input_index=index.astype(np.int64),
+        rejected_index=rejected,
+        rejected_reason=reasons,
+        restarts=restarts,
+        events_topic=events_topic,
+    )
+
+
+def _events_topic(inputs: str) -> str:
+    """``C/events`` beside ``C/indentation``."""
+    return inputs.rsplit("/", 1)[0] + "/events"
+
+
+def _node_events(
+    bag: Bag,
+    inputs: str,
+    stamps: NDArray[np.int64],
+    order: NDArray[np.int64],
+    columns: dict[str, NDArray],
+) -> tuple[str | None, tuple[Restart, ...], dict[int, str]]:
+    """``(events topic, restarts, {command index: reason})`` from the ContactEvents logged
+    beside ``inputs``; an event that names a command the log does not hold is an error."""
+    topic = _events_topic(inputs)
+    if topic not in bag.topics:
+        return None, (), {}
+    if bag.topics[topic] != EVENT:
+        raise InputError(f"events topic {topic!r} has type {bag.topics[topic]!r}; expected {EVENT!r}")
+    # Commands in recording order: the node counts them in the order it received them.
+    received = np.argsort(order, kind="stable")
+    raw_stamp = columns.get("stamp_ns", stamps)[received]
+    restarts: list[Restart] = []
+    refused: dict[int, str] = {}
+    for message in bag.messages([topic]):
+        event = message.msg
+        if event.kind == COMMAND_REJECTED:
+            k = int(event.command_index)
+            stamp = event.command_stamp.sec * 1_000_000_000 + event.command_stamp.nanosec
+            if k >= received.size or int(raw_stamp[k]) != stamp:
+                raise InputError(
+                    f"{topic}: the event at {message.log_time_ns} ns rejects command {k} stamped "
+                    f"{stamp} ns, which {inputs!r} does not hold (it has {received.size} commands); "
+                    "the log is incomplete"
+                )
+            refused[k] = event.reason or "rejected by the node"
+        elif event.kind in (RESET, PARAMETERS):
+            if event.kind == PARAMETERS and not event.contact_yaml:
+                raise InputError(f"{topic}: PARAMETERS event at {message.log_time_ns} ns has no contact_yaml")
+            stamp = event.header.stamp.sec * 1_000_000_000 + event.header.stamp.nanosec
+            restarts.append(
+                Restart(int(event.kind), stamp or message.log_time_ns, message.order, event.contact_yaml)
+            )
+        else:
+            raise InputError(f"{topic}: event of unknown kind {event.kind} at {message.log_time_ns} ns")
+    return topic, tuple(sorted(restarts, key=lambda r: r.order)), refused
+
+
+def _node_verdicts(
+    stamps: NDArray[np.int64],
+    order: NDArray[np.int64],
+    mode: NDArray[np.uint8],
+    value: NDArray[np.float64],
+    refused: dict[int, str],
+    restarts: tuple[Restart, ...],
+) -> tuple[NDArray[np.bool_], NDArray[np.int64], NDArray[np.int64], tuple[str, ...]]:
+    """The node's verdict on every command, by position in ``stamps`` (the topic's recording
+    order): ``(accepted mask, index among the commands received, rejected indexes, reasons)``.
+
+    Refused: what the events name, and what the node always refuses (unknown mode, non-finite
+    value, a stamp older than the last accepted command's since the last restart)."""
+    received = np.argsort(order, kind="stable")  # k-th command received -> position
+    index = np.empty(order.size, dtype=np.int64)
+    index[received] = np.arange(order.size)
+    reasons: dict[int, str] = {}
+    for k, reason in refused.items():
+        reasons[int(received[k])] = reason
+    for pos in np.flatnonzero((mode != DEPTH) & (mode != FORCE)).tolist():
+        reasons.setdefault(pos, f"mode must be DEPTH (0) or FORCE (1) (got {mode[pos]})")
+    for pos in np.flatnonzero(~np.isfinite(value)).tolist():
+        reasons.setdefault(pos, f"{'force' if mode[pos] == FORCE else 'depth'} must be finite")
+    # Older stamps, per stretch between restarts: the last accepted stamp is the running
+    # maximum of the candidates before (a candidate refused for its stamp is below it).
+    segment = np.searchsorted(np.array([r.order for r in restarts], dtype=np.int64), order)
+    for seg in np.unique(segment).tolist():
+        positions = received[np.isin(received, np.flatnonzero(segment == seg))]
+        candidates = np.array([p for p in positions.tolist() if p not in reasons], dtype=np.int64)
+        if candidates.size < 2:
+            continue
+        last = np.maximum.accumulate(stamps[candidates])
+        older = np.flatnonzero(stamps[candidates][1:] < last[:-1]) + 1
+        for j in older.tolist():
+            p = int(candidates[j])
+            reasons[p] = f"header.stamp {stamps[p]} ns is older than the last command's {last[j - 1]} ns"
+    keep = np.ones(order.size, dtype=np.bool_)
+    keep[list(reasons)] = False
+    rejected_positions = sorted(reasons, key=lambda p: index[p])
+    return (
+        keep,
+        index,
+        index[np.array(rejected_positions, dtype=np.int64)] if reasons else np.empty(0, dtype=np.int64),
+        tuple(reasons[p] for p in rejected_positions),
     )
 
 
@@ -257,7 +440,9 @@ class ModelRun:
     input_columns: dict[str, NDArray]  # StepOutput field -> (n,) one value per input
     model_force: NDArray[np.float64]  # (m,) N, at Experiment.measured_ns
     wall_time: float  # s spent simulating
-    model: str  # ContactSimulator.model: "closed_form" or "time_stepped"
+    model: str  # ContactSimulator.model of the first input: "closed_form" or "time_stepped"
+    #: (n,) the model each input ran with (a PARAMETERS event may change it).
+    input_model: NDArray[np.str_] | None = None
 
     @property
     def input_outputs(self) -> list[StepOutput]:
@@ -270,47 +455,123 @@ class ModelRun:
         return [StepOutput(*values) for values in zip(*columns, strict=True)]
 
 
+def _contact_of(restart: Restart, contact_id: str) -> ContactConfig:
+    """The configuration a PARAMETERS event carries for ``contact_id``."""
+    import yaml
+
+    from viscoadh_ros.core.config import SceneConfig
+
+    try:
+        scene = SceneConfig.from_dict(yaml.safe_load(restart.contact_yaml))
+    except (yaml.YAMLError, ValueError) as exc:
+        raise InputError(f"PARAMETERS event at {restart.ns} ns: unusable contact_yaml ({exc})") from None
+    ids = [c.id for c in scene.contacts]
+    if contact_id not in ids:
+        if len(ids) != 1:
+            raise InputError(f"PARAMETERS event at {restart.ns} ns holds contacts {ids}, not {contact_id!r}")
+        contact_id = ids[0]
+    return scene.contact(contact_id)
+
+
 def run_model(
     contact: ContactConfig,
     experiment: Experiment,
     *,
     progress: Callable[[int], Any] | None = None,
+    parameters: bool = True,
 ) -> ModelRun:
     """Run ``contact``'s model over ``experiment`` from a fresh state (the node's event loop).
 
     Every event under depth control (a depth input, or a measured stamp while a depth is
     held: `ContactSimulator.advance` then steps to that time holding the depth) runs in one
     `ContactSimulator.step_depths` call per stretch between force inputs; force inputs and
-    the stamps they hold run event by event. ``progress(k)`` is called with the number of
-    events done since the last call.
+    the stamps they hold run event by event. A node log's restarts (RESET, PARAMETERS) start
+    a fresh simulator where they were logged, and the next input a new time base, as the node
+    does; ``parameters=False`` keeps ``contact`` through PARAMETERS events (a fit's trial).
+    ``progress(k)`` is called with the number of events done since the last call.
     """
-    from viscoadh_ros.core.simulator import (
-        STEP_OUTPUT_FIELDS,
-        ContactSimulator,  # numba: loaded only to simulate
-    )
+    from viscoadh_ros.core.simulator import STEP_OUTPUT_FIELDS
 
-    n, m = experiment.input_ns.size, experiment.measured_ns.size
-    stamps = np.concatenate([experiment.input_ns, experiment.measured_ns])
-    is_input = np.concatenate([np.ones(n, np.bool_), np.zeros(m, np.bool_)])
-    index = np.concatenate([np.arange(n), np.arange(m)])
-    # By stamp; at equal stamps in recording order (see the module docstring).
-    order = np.lexsort((np.concatenate([experiment.input_order, experiment.measured_order]), stamps))
-    times, is_input, index = experiment.time(stamps)[order], is_input[order], index[order]
-    # The control each event runs under: an input's own, a measured stamp the last input's
-    # (depth 0 before the first input: a fresh simulator holds its depth).
-    last_input = np.maximum.accumulate(np.where(is_input, np.arange(order.size), -1))
-    seen = last_input >= 0
-    held_mode = np.full(order.size, DEPTH, dtype=np.uint8)
-    held_mode[seen] = experiment.input_mode[index[last_input[seen]]]
-    held_value = np.zeros(order.size)
-    held_value[seen] = experiment.input_value[index[last_input[seen]]]
-    sim = ContactSimulator(contact)
+    n, m, r = experiment.input_ns.size, experiment.measured_ns.size, len(experiment.restarts)
+    restarts = experiment.restarts
+    kind = np.concatenate([np.zeros(n, np.int8), np.ones(m, np.int8), np.full(r, 2, np.int8)])
+    index = np.concatenate([np.arange(n), np.arange(m), np.arange(r)])
+    stamps = np.concatenate(
+        [experiment.input_ns, experiment.measured_ns, np.array([x.ns for x in restarts], dtype=np.int64)]
+    )
+    orders = np.concatenate(
+        [experiment.input_order, experiment.measured_order, np.array([x.order for x in restarts], np.int64)]
+    )
+    if experiment.by_arrival:
+        sequence = np.argsort(orders, kind="stable")
+    else:
+        # By stamp; at equal stamps in recording order (see the module docstring).
+        sequence = np.lexsort((orders, stamps))
+    kind, index, stamps = kind[sequence], index[sequence], stamps[sequence]
+
     columns = {name: np.empty(n, dtype=dtype) for name, dtype in _column_dtypes(STEP_OUTPUT_FIELDS).items()}
+    input_model = np.empty(n, dtype="<U16")
     model_force = np.empty(m)
     started = wallclock.perf_counter()
+    # Pieces between restarts; each: measured samples before its first input (the node's hold
+    # timer on a fresh contact), then the inputs and samples from its first input on.
+    cuts = np.flatnonzero(kind == 2)
+    for lo, hi in zip(np.concatenate(([0], cuts + 1)), np.concatenate((cuts, [kind.size])), strict=True):
+        if lo > 0 and parameters and restarts[int(index[lo - 1])].kind == PARAMETERS:
+            contact = _contact_of(restarts[int(index[lo - 1])], contact.id)
+        inputs = np.flatnonzero(kind[lo:hi] == 0)
+        first = lo + int(inputs[0]) if inputs.size else hi
+        if first > lo:
+            _at_rest(contact, index[lo:first], model_force)
+        if first < hi:
+            model = _run_piece(
+                contact,
+                experiment,
+                stamps[first:hi],
+                kind[first:hi] == 0,
+                index[first:hi],
+                columns,
+                model_force,
+            )
+            input_model[index[first:hi][kind[first:hi] == 0]] = model
+        if progress is not None:
+            progress(int(hi - lo))
+    return ModelRun(
+        columns, model_force, wallclock.perf_counter() - started, str(input_model[0]), input_model
+    )
+
+
+def _at_rest(contact: ContactConfig, index: NDArray[np.int64], model_force: NDArray[np.float64]) -> None:
+    """Measured samples after a restart, before the next accepted command: the node's hold
+    timer leaves a contact that has had no command since start or reset alone (nothing to hold;
+    holding depth 0 would touch the surface), so it publishes the fresh contact's output."""
+    from viscoadh_ros.core.simulator import ContactSimulator
+
+    model_force[index] = ContactSimulator(contact).output.force
+
+
+def _run_piece(
+    contact: ContactConfig,
+    experiment: Experiment,
+    stamps: NDArray[np.int64],
+    is_input: NDArray[np.bool_],
+    index: NDArray[np.int64],
+    columns: dict[str, NDArray],
+    model_force: NDArray[np.float64],
+) -> str:
+    """Inputs and measured samples from a fresh simulator whose time base starts at the first
+    (an input) stamp, as the node's first command after start or a restart; returns the model."""
+    from viscoadh_ros.core.simulator import STEP_OUTPUT_FIELDS, ContactSimulator
+
+    times = (stamps - stamps[0]) * 1e-9
+    # The control each event runs under: an input's own, a measured stamp the last input's.
+    last_input = np.maximum.accumulate(np.where(is_input, np.arange(is_input.size), -1))
+    held_mode = experiment.input_mode[index[last_input]]
+    held_value = experiment.input_value[index[last_input]]
+    sim = ContactSimulator(contact)
     # Stretches of consecutive events of one control mode.
     bounds = np.flatnonzero(np.diff(held_mode.astype(np.int8))) + 1
-    for lo, hi in zip(np.concatenate(([0], bounds)), np.concatenate((bounds, [order.size])), strict=True):
+    for lo, hi in zip(np.concatenate(([0], bounds)), np.concatenate((bounds, [times.size])), strict=True):
         if held_mode[lo] == DEPTH:
             _depth_stretch(
                 sim, times[lo:hi], is_input[lo:hi], index[lo:hi], held_value[lo:hi], columns, model_force
@@ -324,9 +585,7 @@ def run_model(
                         columns[name][i] = getattr(output, name)
                 else:
                     model_force[i] = (sim.advance(t) if t > sim.time else sim.output).force
-        if progress is not None:
-            progress(int(hi - lo))
-    return ModelRun(columns, model_force, wallclock.perf_counter() - started, sim.model)
+    return sim.model
 
 
 def _column_dtypes(names: tuple[str, ...]) -> dict[str, type]:
@@ -347,7 +606,9 @@ def _depth_stretch(
     measured stamp steps to its time holding the depth when time has passed (`advance`),
     else reads the last output. Writes the inputs' columns and the measured forces."""
     before = sim.output.force
-    times = np.maximum(times, sim.time)
+    # The node steps to max(stamp, the contact's time): a command stamped before a hold tick
+    # it arrived after runs at the tick's time.
+    times = np.maximum.accumulate(np.maximum(times, sim.time))
     previous = np.concatenate(([sim.time], times[:-1]))
     steps = is_input | (times > previous)
     result = sim.step_depths(times[steps], depth[steps])

@@ -285,6 +285,31 @@ def render_markdown(results: dict[str, Any], figure: Path | None, notes: str | N
             [[stage, f"{share:.1%}"] for stage, share in replay["time_share"].items()],
         )
         lines += [""]
+    if "batch" in results:
+        run = results["batch"]
+        lines += [
+            "## Batch throughput (replay on a local Dask cluster)",
+            "",
+            f"`viscoadh replay 'archive/*.mcap' -o OUT --workers N` over {run['bags']} node logs of "
+            f"{_g(run['seconds_per_bag'])} s of 1 kHz commands each; wall time includes starting the "
+            "cluster (its own column: an empty cluster started and stopped).",
+            "",
+        ]
+        lines += _table(
+            ["workers", "bags", "wall s", "bags/minute", "cluster start s", "load average before"],
+            [
+                [
+                    str(r["workers"]),
+                    str(r["bags"]),
+                    _g(r["wall_s"]),
+                    _g(r["bags_per_minute"]),
+                    _g(r["cluster_start_s"]),
+                    _g(r.get("load_average_1min", float("nan"))),
+                ]
+                for r in run["rows"]
+            ],
+        )
+        lines += [""]
     if "soak" in results:
         soak = results["soak"]
         lines += [

@@ -9,7 +9,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-SECTIONS = ("kernel", "accuracy", "node", "replay")
+SECTIONS = ("kernel", "accuracy", "node", "replay", "batch")
 #: The results keys each section writes (the soak is asked for by --soak, not --sections); a
 #: merge replaces exactly these.
 SECTION_KEYS = {
@@ -17,6 +17,7 @@ SECTION_KEYS = {
     "accuracy": ("accuracy", "presets"),
     "node": ("node", "startup_s"),
     "replay": ("replay",),
+    "batch": ("batch",),
     "soak": ("soak",),
 }
 #: Top-level keys that describe the run the report header names.
@@ -41,6 +42,9 @@ class Plan:
     node_duration_s: float
     replay_seconds: float
     replay_repeats: int
+    batch_bags: int = 12
+    batch_seconds: float = 20.0
+    batch_workers: tuple[int, ...] = (1, 2)
 
 
 FULL = Plan(
@@ -74,6 +78,8 @@ QUICK = Plan(
     node_duration_s=5.0,
     replay_seconds=10.0,
     replay_repeats=1,
+    batch_bags=4,
+    batch_seconds=2.0,
 )
 
 
@@ -149,6 +155,13 @@ def run(
 
         progress(f"replay: {plan.replay_seconds:g} s of 1 kHz commands")
         results["replay"] = replay_benchmark(seconds=plan.replay_seconds, repeats=plan.replay_repeats)
+    if "batch" in sections:
+        from viscoadh_ros.bench.batch_throughput import batch_benchmark
+
+        progress(f"batch: {plan.batch_bags} bags of {plan.batch_seconds:g} s, workers {plan.batch_workers}")
+        results["batch"] = batch_benchmark(
+            bags=plan.batch_bags, seconds=plan.batch_seconds, workers=plan.batch_workers
+        )
     if soak_minutes is not None:
         from viscoadh_ros.bench.soak import soak
 

@@ -13,7 +13,14 @@ from pathlib import Path
 
 import yaml
 
-from viscoadh_ros.cli.replay import add_input_arguments, open_experiment
+from viscoadh_ros.cli._paths import refuse_overwrite
+from viscoadh_ros.cli.replay import (
+    add_input_arguments,
+    batch_bags,
+    batch_main,
+    input_options,
+    open_experiment,
+)
 from viscoadh_ros.core.errors import InputError
 from viscoadh_ros.experiment import choose_contact
 from viscoadh_ros.fitting import fit, parameter_names, parse_free, unit_of
@@ -41,12 +48,18 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="K",
         help="number of Kelvin elements of the rheology (default 1: standard solid)",
     )
-    parser.add_argument("-o", "--output", type=Path, required=True, help="scene YAML to write")
+    parser.add_argument(
+        "-o", "--output", type=Path, required=True, help="scene YAML to write (a folder in batch mode)"
+    )
 
 
 def main(args: argparse.Namespace) -> int:
+    bags = batch_bags(args)
+    if bags is not None:
+        return _batch(args, bags)
     if args.output.suffix not in (".yaml", ".yml"):
         raise InputError(f"--output must be a .yaml file (got {str(args.output)!r})")
+    refuse_overwrite([args.bag, args.scene], [("--output", args.output)])
     _, scene, experiment = open_experiment(args)
     contact = choose_contact(scene, args.contact, experiment.input_topic)
     free = parse_free(args.free, args.kelvin) if args.free else parameter_names(args.kelvin)
@@ -64,3 +77,16 @@ def main(args: argparse.Namespace) -> int:
             print(f"  {name:>16} = {value:.6g} {unit_of(name)} (held)")
     print(f"fit error: RMSE {result.rmse:.6g} N, max {result.max_error:.6g} N\nwrote {args.output}")
     return 0
+
+
+def _batch(args: argparse.Namespace, bags: list) -> int:
+    """Many bags on a Dask cluster: ``fitting.fit_file(path, options)`` per bag (one summary
+    row; it writes ``options["output"]``, the fitted scene, beside the others in OUTPUT)."""
+    import viscoadh_ros.fitting as fitting
+
+    if not hasattr(fitting, "fit_file"):
+        raise InputError("batch fit needs viscoadh_ros.fitting.fit_file, which this version lacks")
+    options = {**input_options(args), "free": args.free, "kelvin": args.kelvin}
+    return batch_main(
+        "fit", args, bags, task="viscoadh_ros.fitting:fit_file", suffix=".fit.yaml", options=options
+    )

@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
+from viscoadh_ros.cli._paths import refuse_overwrite
 from viscoadh_ros.core.errors import InputError
 from viscoadh_ros.io.csv_io import check_output_folder, read_columns
 from viscoadh_ros.plotting import Curve, JkrReference, plot_loops
@@ -71,6 +72,7 @@ def _mcap_curves(args: argparse.Namespace):
 
 
 def main(args: argparse.Namespace) -> int:
+    refuse_overwrite([args.input, args.scene], [("--output", args.output)])
     check_output_folder(args.output)
     stored = None
     if args.input.suffix.lower() == ".csv":

@@ -3,6 +3,11 @@
 OUT holds the model's ``<contact>/state`` (ContactState) and ``<contact>/wrench``
 (WrenchStamped) on the input stamps, plus the scene, so it can be plotted or replayed again.
 The summary (RMSE, max error, pull-off forces, speed) is printed and, with ``--json``, written.
+
+Batch mode (several bags, a glob, ``--workers`` or ``--scheduler``): ``-o`` is a folder that
+receives ``<bag>.replay.mcap`` per bag and ``summary.csv`` (one row per bag, see
+:mod:`viscoadh_ros.batch`); the bags run in parallel on a Dask cluster. The same options and
+:func:`batch_main` serve ``viscoadh fit``.
 """
 
 from __future__ import annotations
@@ -13,6 +18,7 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from viscoadh_ros.cli._paths import refuse_overwrite
 from viscoadh_ros.core.errors import InputError
 from viscoadh_ros.experiment import (
     Experiment,
@@ -30,7 +36,11 @@ if TYPE_CHECKING:
 
 def add_input_arguments(parser: argparse.ArgumentParser) -> None:
     """Options that choose the recorded experiment (shared by replay and fit)."""
-    parser.add_argument("bag", type=Path, help="an .mcap file or a rosbag2 folder")
+    parser.add_argument(
+        "bag",
+        nargs="+",
+        help="an .mcap file or a rosbag2 folder; several, or a glob ('lab/*.mcap'), for a batch",
+    )
     parser.add_argument("--scene", type=Path, help="scene YAML (default: the one stored in BAG by the node)")
     parser.add_argument("--contact", help="contact id in the scene (default: the only one)")
     parser.add_argument(
@@ -51,6 +61,69 @@ def add_input_arguments(parser: argparse.ArgumentParser) -> None:
         action="store_true",
         help="read unfinished (truncated) files up to their last complete chunk",
     )
+    batch = parser.add_argument_group("batch mode (several bags; needs the 'batch' extra: Dask)")
+    batch.add_argument(
+        "--workers",
+        type=int,
+        metavar="N",
+        help="worker processes of the local Dask cluster (default 1; implies batch mode)",
+    )
+    batch.add_argument(
+        "--scheduler",
+        metavar="ADDRESS",
+        help="run on an existing Dask cluster (tcp://host:8786) instead; its workers must see the bags",
+    )
+    batch.add_argument("--summary", type=Path, help="summary table to write (default: OUTPUT/summary.csv)")
+
+
+def batch_bags(args: argparse.Namespace) -> list[Path] | None:
+    """The bags of a batch, or None for one bag (then ``args.bag`` becomes its Path)."""
+    from viscoadh_ros import batch
+
+    if args.workers is not None and args.workers < 1:
+        raise InputError(f"--workers must be >= 1 (got {args.workers})")
+    if batch.is_batch(args.bag, workers=args.workers, scheduler=args.scheduler):
+        return batch.expand_bags(args.bag)
+    if args.summary is not None:
+        raise InputError("--summary is for batch mode (several bags, --workers or --scheduler)")
+    args.bag = Path(args.bag[0])
+    return None
+
+
+def batch_main(
+    verb: str,
+    args: argparse.Namespace,
+    bags: list[Path],
+    *,
+    task: str,
+    suffix: str,
+    options: dict,
+) -> int:
+    """Run ``task`` over ``bags`` (``options`` plus each bag's ``output`` file in the folder
+    ``args.output``), write the summary table; 0 when every bag succeeded, else 1."""
+    from viscoadh_ros import batch
+
+    folder: Path = args.output
+    if folder.exists() and not folder.is_dir():
+        raise InputError(f"--output must be a folder in batch mode ({str(folder)!r} is a file)")
+    outputs = [folder / name for name in batch.output_names(bags, suffix)]
+    summary = args.summary if args.summary is not None else folder / "summary.csv"
+    json_path = getattr(args, "json", None)
+    refuse_overwrite(
+        [*bags, options.get("scene")],
+        [("--summary", summary), ("--json", json_path), *(("--output", o) for o in outputs)],
+    )
+    folder.mkdir(parents=True, exist_ok=True)
+    per_bag = [{**options, "output": str(o)} for o in outputs]
+    rows = batch.run_batch(task, bags, per_bag, workers=args.workers, scheduler=args.scheduler)
+    batch.write_summary(summary, rows)
+    if json_path is not None:
+        json_path.write_text(json.dumps(rows, indent=2) + "\n", encoding="utf-8")
+    failed = [row for row in rows if row.get("status") != "ok"]
+    print(f"{verb}: {len(rows) - len(failed)} of {len(rows)} bags done; wrote {summary} and {folder}/")
+    for row in failed:
+        print(f"viscoadh {verb}: failed: {row['bag']}: {row.get('error', '')}", file=sys.stderr)
+    return 1 if failed else 0
 
 
 def open_experiment(args: argparse.Namespace) -> tuple[Bag, SceneConfig, Experiment]:
@@ -84,26 +157,70 @@ def open_experiment(args: argparse.Namespace) -> tuple[Bag, SceneConfig, Experim
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_input_arguments(parser)
-    parser.add_argument("-o", "--output", type=Path, required=True, help="output .mcap file")
+    parser.add_argument(
+        "-o", "--output", type=Path, required=True, help="output .mcap file (a folder in batch mode)"
+    )
     parser.add_argument("--json", type=Path, help="also write the summary to this JSON file")
 
 
+def input_options(args: argparse.Namespace) -> dict:
+    """The shared input options as plain values (what a batch task receives)."""
+    return {
+        "scene": None if args.scene is None else str(args.scene),
+        "contact": args.contact,
+        "depth_topic": args.depth_topic,
+        "force_topic": args.force_topic,
+        "flip_force": args.flip_force,
+        "recover": args.recover,
+    }
+
+
 def main(args: argparse.Namespace) -> int:
+    bags = batch_bags(args)
+    if bags is not None:
+        return batch_main(
+            "replay",
+            args,
+            bags,
+            task="viscoadh_ros.cli.replay:replay_file",
+            suffix=".replay.mcap",
+            options=input_options(args),
+        )
     if args.output.suffix != ".mcap":
         raise InputError(f"--output must be an .mcap file (got {str(args.output)!r})")
+    refuse_overwrite([args.bag, args.scene], [("--output", args.output), ("--json", args.json)])
+    result, experiment = replay_one(args, progress=True)
+    skipped = experiment.rejected_index.size
+    print(
+        f"replayed {experiment.input_ns.size} inputs of {result['contact']} over "
+        f"{experiment.duration:.3f} s at {result['replay_speed_x_real_time']:.3g}x real time"
+        + (f" (skipped {skipped} the node rejected)" if skipped else "")
+        + (f" ({len(experiment.restarts)} resets/parameter changes applied)" if experiment.restarts else "")
+        + f"\nforce error vs {experiment.force_topic}: RMSE {result['rmse_N']:.6g} N, "
+        f"max {result['max_error_N']:.6g} N ({result['samples']} samples)\n"
+        f"pull-off force: measured {_pull_off_text(result['measured_pull_off_force_N'])}, "
+        f"model {_pull_off_text(result['model_pull_off_force_N'])}\n"
+        f"wrote {args.output}"
+    )
+    if args.json is not None:
+        args.json.write_text(json.dumps(result, indent=2) + "\n", encoding="utf-8")
+    return 0
+
+
+def replay_one(args: argparse.Namespace, *, progress: bool = False) -> tuple[dict, Experiment]:
+    """Replay ``args.bag`` into ``args.output``: the summary row and the experiment."""
     _, scene, experiment = open_experiment(args)
     contact = choose_contact(scene, args.contact, experiment.input_topic)
 
-    from tqdm import (
-        tqdm,  # progress only on a terminal (tqdm disables itself otherwise)
-    )
+    from tqdm import tqdm  # progress only on a terminal (tqdm disables itself otherwise)
 
     events = experiment.input_ns.size + experiment.measured_ns.size
-    with tqdm(total=events, unit="step", file=sys.stderr, disable=None, leave=False) as bar:
+    with tqdm(
+        total=events, unit="step", file=sys.stderr, disable=None if progress else True, leave=False
+    ) as bar:
         run = run_model(contact, experiment, progress=bar.update)
     summary = compare(experiment, run)
     _write_output(args.output, scene, contact.id, experiment, run)
-
     result = {
         "bag": str(args.bag),
         "contact": contact.id,
@@ -111,19 +228,36 @@ def main(args: argparse.Namespace) -> int:
         "force_topic": experiment.force_topic,
         "output": str(args.output),
         **summary.as_dict(),
+        **_event_counts(experiment),
     }
-    print(
-        f"replayed {experiment.input_ns.size} inputs of {contact.id} over {experiment.duration:.3f} s "
-        f"at {summary.speed:.3g}x real time\n"
-        f"force error vs {experiment.force_topic}: RMSE {summary.rmse:.6g} N, max {summary.max_error:.6g} N "
-        f"({summary.samples} samples)\n"
-        f"pull-off force: measured {_pull_off_text(summary.measured_pull_off)}, "
-        f"model {_pull_off_text(summary.model_pull_off)}\n"
-        f"wrote {args.output}"
+    return result, experiment
+
+
+def replay_file(path: str, options: dict) -> dict:
+    """One bag of a batch (run on a Dask worker): replay ``path`` into ``options["output"]``;
+    the summary row. ``options``: the keys of :func:`input_options` plus ``output``."""
+    args = argparse.Namespace(
+        bag=Path(path),
+        output=Path(options["output"]),
+        **{k: v for k, v in options.items() if k not in ("output", "scene")},
+        scene=None if options.get("scene") is None else Path(options["scene"]),
     )
-    if args.json is not None:
-        args.json.write_text(json.dumps(result, indent=2) + "\n", encoding="utf-8")
-    return 0
+    result, _ = replay_one(args)
+    return {"status": "ok", **result}
+
+
+def _event_counts(experiment: Experiment) -> dict[str, int]:
+    """What the node did besides accepting commands, as the summary reports it."""
+    from viscoadh_ros.experiment import PARAMETERS, RESET
+
+    kinds = [r.kind for r in experiment.restarts]
+    return {
+        "commands": int(experiment.input_ns.size + experiment.rejected_index.size),
+        "commands_rejected": int(experiment.rejected_index.size),
+        "resets": kinds.count(RESET),
+        "parameter_changes": kinds.count(PARAMETERS),
+        "restarts": len(kinds),
+    }
 
 
 def _pull_off_text(force: float | None) -> str:
@@ -142,36 +276,38 @@ def _write_output(
     import numpy as np
 
     from viscoadh_ros.io import cdr
-    from viscoadh_ros.io.mcap_log import TopicData, write_mcap
+    from viscoadh_ros.io.mcap_bulk import write_columns
+    from viscoadh_ros.io.mcap_log import TopicData
     from viscoadh_ros.ros.conversions import MODEL_CODES, STATE_OUTPUT_FIELDS
 
     fields = list(STATE_OUTPUT_FIELDS)
     rows = np.column_stack([run.input_columns[name] for name in fields]).astype(np.float64)
     columns = dict(zip(fields, rows.T, strict=True))
-    count = rows.shape[0]
+    received, rejected = experiment.counters
+    models = run.input_model if run.input_model is not None else np.full(rows.shape[0], run.model)
     state = {
         **columns,
-        "model": MODEL_CODES[run.model],
-        "commands_received": np.arange(1, count + 1),
-        "commands_rejected": 0,
+        "model": np.array([MODEL_CODES[name] for name in models.tolist()], dtype=np.uint8),
+        "commands_received": received,
+        "commands_rejected": rejected,
     }
     frame, stamps = scene.node.frame_id, experiment.input_ns
     if path.exists():
         path.unlink()
-    write_mcap(
+    write_columns(
         path,
         [
             TopicData(
                 f"/{contact_id}/state",
                 cdr.CONTACT_STATE,
                 stamps,
-                cdr.encode(cdr.CONTACT_STATE, stamps, frame, state),
+                cdr.encode_array(cdr.CONTACT_STATE, stamps, frame, state),
             ),
             TopicData(
                 f"/{contact_id}/wrench",
                 cdr.WRENCH,
                 stamps,
-                cdr.encode(cdr.WRENCH, stamps, frame, {"wrench.force.z": columns["force"]}),
+                cdr.encode_array(cdr.WRENCH, stamps, frame, {"wrench.force.z": columns["force"]}),
             ),
         ],
         scene=scene.to_dict(),

@@ -1,17 +1,21 @@
 """Read ROS 2 recordings: one ``.mcap`` file or a rosbag2 folder (``metadata.yaml`` + ``*.mcap``).
 
 Messages are deserialised with :func:`rclpy.serialization.deserialize_message` into the
-installed message classes, or read in bulk as raw CDR (:meth:`Bag.raw`) for the fixed-layout
-decoders of :mod:`viscoadh_ros.io.cdr`. Chunks are split into records here (one ``struct`` call
-per record) rather than by the ``mcap`` package's record objects, which cost several times
-more per message. A file that was not finished (a recorder killed mid-run) has no
-summary: it is read record by record up to the last complete chunk; :class:`Bag` refuses
-it with a clear :class:`InputError` unless ``recover=True``.
+installed message classes, or read in bulk as raw CDR (:meth:`Bag.raw`, :meth:`Bag.rows`) for
+the fixed-layout decoders of :mod:`viscoadh_ros.io.cdr`. The file is walked here, record by
+record with one ``struct`` call each (message indexes and the summary are skipped: the
+``mcap`` package's reader parses every index entry as an object, which cost more than the
+messages); a chunk's message records are located the same way and then read as columns
+(channel, log time, payload offset and size as numpy arrays; payloads of one length as one
+(n, L) array). A file that was not finished (a recorder killed mid-run) has no footer: it is
+read up to the last complete chunk; :class:`Bag` refuses it with a clear :class:`InputError`
+unless ``recover=True``.
 """
 
 from __future__ import annotations
 
 import struct
+import zlib
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
 from io import BytesIO
@@ -21,10 +25,10 @@ from typing import Any
 import numpy as np
 import yaml
 from mcap.data_stream import ReadDataStream
-from mcap.exceptions import InvalidMagic, McapError
+from mcap.exceptions import McapError
 from mcap.opcode import Opcode
-from mcap.records import Channel, Chunk, Footer, Message, Metadata, Schema
-from mcap.stream_reader import StreamReader, get_chunk_data_stream
+from mcap.records import Channel, Chunk, Metadata, Schema
+from mcap.stream_reader import get_chunk_data_stream
 from numpy.typing import NDArray
 from rclpy.serialization import deserialize_message
 
@@ -47,18 +51,47 @@ class RecordedMessage:
 
 
 @dataclass
+class _Part:
+    """Messages of one topic from one chunk (or one top-level message record): payload ``k``
+    is ``buffer[starts[k] : starts[k] + sizes[k]]``."""
+
+    buffer: NDArray[np.uint8]
+    starts: NDArray[np.int64]
+    sizes: NDArray[np.int64]
+    log_ns: NDArray[np.int64]
+    order: NDArray[np.int64]
+
+
+@dataclass
 class _Topic:
     type_name: str
     encoding: str
-    log_ns: list[int] = field(default_factory=list)  # log time of each message, ns
-    order: list[int] = field(default_factory=list)  # position in the recording
-    data: list[bytes] = field(default_factory=list)  # CDR payloads
+    parts: list[_Part] = field(default_factory=list)
 
+    @property
+    def count(self) -> int:
+        return sum(p.starts.size for p in self.parts)
+
+    def column(self, name: str) -> NDArray[np.int64]:
+        values = [getattr(p, name) for p in self.parts]
+        return np.concatenate(values) if values else np.empty(0, dtype=np.int64)
+
+    def payloads(self) -> list[bytes]:
+        return [
+            p.buffer[s : s + z].tobytes()
+            for p in self.parts
+            for s, z in zip(p.starts.tolist(), p.sizes.tolist(), strict=True)
+        ]
+
+
+_RECORD_TYPES = {Opcode.SCHEMA: Schema, Opcode.CHANNEL: Channel, Opcode.METADATA: Metadata}
 
 #: Record header (opcode u8, length u64) and Message record fields before the payload
 #: (channel id u16, sequence u32, log time u64, publish time u64), MCAP's little-endian layout.
 _RECORD_HEADER = struct.Struct("<BQ")
 _MESSAGE_FIELDS = struct.Struct("<HIQQ")
+_CHUNK_FIELDS = struct.Struct("<QQQII")  # start, end, uncompressed size, crc, compression length
+_MAGIC = b"\x89MCAP0\r\n"
 
 
 def _bag_files(path: Path) -> list[Path]:
@@ -112,63 +145,116 @@ class Bag:
     def _read_file(self, file: Path, recover: bool) -> None:
         schemas: dict[int, Schema] = {}
         channels: dict[int, Channel] = {}
+        data = file.read_bytes()
+        if not data.startswith(_MAGIC):
+            raise InputError(f"{str(file)!r} is not an MCAP file")
         finished = False
-        with open(file, "rb") as stream:
-            try:
-                for record in StreamReader(stream, emit_chunks=True, validate_crcs=True).records:
-                    if isinstance(record, Chunk):
-                        self._read_chunk(record, channels, schemas)
-                    elif isinstance(record, Schema):
+        try:
+            position, length = len(_MAGIC), len(data)
+            while position < length and not finished:
+                if position + _RECORD_HEADER.size > length:
+                    raise McapError("the file ends inside a record header")
+                opcode, size = _RECORD_HEADER.unpack_from(data, position)
+                start = position + _RECORD_HEADER.size
+                position = start + size
+                if position > length:
+                    raise McapError(f"a record of {size} bytes overruns the file")
+                if opcode == Opcode.CHUNK:
+                    self._read_chunk(data, start, position, channels, schemas)
+                elif opcode == Opcode.MESSAGE:
+                    buffer = np.frombuffer(data, np.uint8)
+                    self._add_messages(buffer, np.array([start - _RECORD_HEADER.size]), channels, schemas)
+                elif opcode in _RECORD_TYPES:
+                    record = _RECORD_TYPES[opcode].read(ReadDataStream(BytesIO(data[start:position])))
+                    if opcode == Opcode.SCHEMA:
                         schemas[record.id] = record
-                    elif isinstance(record, Channel):
+                    elif opcode == Opcode.CHANNEL:
                         channels[record.id] = record
-                    elif isinstance(record, Message):
-                        self._add(record, channels, schemas)
-                    elif isinstance(record, Metadata):
+                    else:
                         self.metadata.setdefault(record.name, {}).update(record.metadata)
-                    elif isinstance(record, Footer):
-                        finished = True
-            except InvalidMagic:
-                if not finished:
-                    raise InputError(f"{str(file)!r} is not an MCAP file") from None
-            except (McapError, struct.error, ValueError, EOFError) as exc:
-                if not recover:
-                    raise InputError(
-                        f"{str(file)!r} is truncated or damaged ({type(exc).__name__}: {exc}); "
-                        "pass --recover to use the messages up to its last complete chunk"
-                    ) from None
+                elif opcode == Opcode.FOOTER:
+                    finished = True
+            if not finished:
+                raise McapError("the file ends before its footer")
+        except (McapError, struct.error, ValueError, EOFError) as exc:
+            if not recover:
+                raise InputError(
+                    f"{str(file)!r} is truncated or damaged ({type(exc).__name__}: {exc}); "
+                    "pass --recover to use the messages up to its last complete chunk"
+                ) from None
         if not finished:
             self.truncated.append(file)
 
-    def _read_chunk(self, chunk: Chunk, channels: dict[int, Channel], schemas: dict[int, Schema]) -> None:
-        """The records of one chunk (decompressed and CRC-checked by ``mcap``), in order."""
-        stream, length = get_chunk_data_stream(chunk, validate_crc=True)
-        data = memoryview(stream.read(length)) if length else memoryview(b"")
-        topics: dict[int, _Topic] = {}  # channel id -> topic, for this chunk's messages
+    def _read_chunk(
+        self, data: bytes, start: int, end: int, channels: dict[int, Channel], schemas: dict[int, Schema]
+    ) -> None:
+        """The records of one chunk (CRC-checked; decompressed by ``mcap`` if compressed)."""
+        _, _, uncompressed, crc, name_length = _CHUNK_FIELDS.unpack_from(data, start)
+        at = start + _CHUNK_FIELDS.size
+        compression = data[at : at + name_length].decode()
+        (size,) = struct.unpack_from("<Q", data, at + name_length)
+        body_start = at + name_length + 8
+        if body_start + size > end:
+            raise McapError("chunk records overrun the chunk")
+        if compression:
+            chunk = Chunk.read(ReadDataStream(BytesIO(data[start:end])))
+            stream, length = get_chunk_data_stream(chunk, validate_crc=True)
+            records = stream.read(length)
+        else:
+            records = data[body_start : body_start + size]
+            if crc and zlib.crc32(records) != crc:
+                raise McapError("chunk CRC mismatch")
+            if len(records) != uncompressed:
+                raise McapError("chunk size differs from its uncompressed size")
+        length = len(records)
+        starts: list[int] = []  # of the message records
         position = 0
+        unpack = _RECORD_HEADER.unpack_from
         while position < length:
-            opcode, size = _RECORD_HEADER.unpack_from(data, position)
-            start = position + _RECORD_HEADER.size
-            position = start + size
-            if position > length:
-                raise McapError(f"chunk record of {size} bytes overruns its chunk")
+            opcode, size = unpack(records, position)
             if opcode == Opcode.MESSAGE:
-                channel_id, _, log_time, _ = _MESSAGE_FIELDS.unpack_from(data, start)
-                topic = topics.get(channel_id)
-                if topic is None:
-                    topic = topics[channel_id] = self._topic(channel_id, channels, schemas)
-                topic.log_ns.append(log_time)
-                topic.order.append(self._records)
-                topic.data.append(bytes(data[start + _MESSAGE_FIELDS.size : position]))
-                self._records += 1
+                starts.append(position)
             elif opcode in (Opcode.CHANNEL, Opcode.SCHEMA):
-                body = ReadDataStream(BytesIO(data[start:position]))
+                if starts:  # the messages before it, on channels already known
+                    self._add_messages(np.frombuffer(records, np.uint8), np.array(starts), channels, schemas)
+                    starts = []
+                body = ReadDataStream(BytesIO(records[position + 9 : position + 9 + size]))
                 if opcode == Opcode.CHANNEL:
                     channel = Channel.read(body)
                     channels[channel.id] = channel
                 else:
                     schema = Schema.read(body)
                     schemas[schema.id] = schema
+            position += _RECORD_HEADER.size + size
+            if position > length:
+                raise McapError(f"chunk record of {size} bytes overruns its chunk")
+        if starts:
+            self._add_messages(np.frombuffer(records, np.uint8), np.array(starts), channels, schemas)
+
+    def _add_messages(
+        self,
+        buffer: NDArray[np.uint8],
+        starts: NDArray[np.int64],
+        channels: dict[int, Channel],
+        schemas: dict[int, Schema],
+    ) -> None:
+        """Message records at ``starts`` of ``buffer``, as columns per topic, in order."""
+        fields = buffer[starts[:, None] + np.arange(_RECORD_HEADER.size + _MESSAGE_FIELDS.size)]
+        # (n, 31): opcode, record length, channel id, sequence, log time, publish time.
+        record_size = fields[:, 1:9].copy().view("<u8")[:, 0].astype(np.int64)
+        channel_id = fields[:, 9:11].copy().view("<u2")[:, 0]
+        log_ns = fields[:, 15:23].copy().view("<u8")[:, 0].astype(np.int64)
+        if np.any(record_size < _MESSAGE_FIELDS.size):
+            raise McapError("a message record shorter than its fields")
+        order = self._records + np.arange(starts.size, dtype=np.int64)
+        self._records += starts.size
+        payload_start = starts + _RECORD_HEADER.size + _MESSAGE_FIELDS.size
+        payload_size = record_size - _MESSAGE_FIELDS.size
+        for cid in np.unique(channel_id).tolist():
+            mine = channel_id == cid
+            self._topic(cid, channels, schemas).parts.append(
+                _Part(buffer, payload_start[mine], payload_size[mine], log_ns[mine], order[mine])
+            )
 
     def _topic(self, channel_id: int, channels: dict[int, Channel], schemas: dict[int, Schema]) -> _Topic:
         """The topic of a channel, created on its first message."""
@@ -182,13 +268,6 @@ class Bag:
             topic = self._topics[channel.topic] = _Topic(type_name, channel.message_encoding)
         return topic
 
-    def _add(self, record: Message, channels: dict[int, Channel], schemas: dict[int, Schema]) -> None:
-        topic = self._topic(record.channel_id, channels, schemas)
-        topic.log_ns.append(record.log_time)
-        topic.order.append(self._records)
-        topic.data.append(record.data)
-        self._records += 1
-
     @property
     def topics(self) -> dict[str, str]:
         """Topic name -> ``pkg/msg/Type`` of every topic with messages."""
@@ -196,15 +275,30 @@ class Bag:
 
     def message_count(self, topic: str) -> int:
         """Number of messages recorded on ``topic``."""
-        return len(self._topics[topic].data)
+        return self._topics[topic].count
+
+    def _cdr(self, topic: str) -> _Topic:
+        info = self._topics[topic]
+        if info.encoding != "cdr":
+            raise InputError(f"topic {topic!r} has message encoding {info.encoding!r}, not cdr")
+        return info
 
     def raw(self, topic: str) -> tuple[NDArray[np.int64], NDArray[np.int64], list[bytes]]:
         """``(log_ns, order, payloads)`` of ``topic`` in recording order: log times (ns) and
         positions in the recording, shape (n,), and the n CDR payloads, undecoded."""
-        info = self._topics[topic]
-        if info.encoding != "cdr":
-            raise InputError(f"topic {topic!r} has message encoding {info.encoding!r}, not cdr")
-        return np.array(info.log_ns, dtype=np.int64), np.array(info.order, dtype=np.int64), info.data
+        info = self._cdr(topic)
+        return info.column("log_ns"), info.column("order"), info.payloads()
+
+    def rows(self, topic: str) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.uint8] | None]:
+        """:meth:`raw` as columns: the payloads as one (n, L) uint8 array when they all have
+        one length L (a fixed-layout type with one frame id), else None."""
+        info = self._cdr(topic)
+        sizes = info.column("sizes")
+        if sizes.size == 0 or np.any(sizes != sizes[0]):
+            return info.column("log_ns"), info.column("order"), None
+        width = np.arange(int(sizes[0]))
+        rows = np.concatenate([p.buffer[p.starts[:, None] + width] for p in info.parts])
+        return info.column("log_ns"), info.column("order"), rows
 
     def resolve(self, name: str) -> str:
         """The recorded topic called ``name``, also matched without its namespace prefix.
@@ -233,9 +327,9 @@ class Bag:
             if topic.encoding != "cdr":
                 raise InputError(f"topic {name!r} has message encoding {topic.encoding!r}, not cdr")
             cls = message_class(topic.type_name)
+            log_ns, order = topic.column("log_ns").tolist(), topic.column("order").tolist()
             streams.extend(
-                (t, order, name, cls, data)
-                for t, order, data in zip(topic.log_ns, topic.order, topic.data, strict=True)
+                (t, k, name, cls, data) for t, k, data in zip(log_ns, order, topic.payloads(), strict=True)
             )
         streams.sort(key=lambda item: (item[0], item[1]))
         for log_time, order, name, cls, data in streams:

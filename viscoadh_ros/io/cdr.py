@@ -130,19 +130,23 @@ class Packer:
         return bytes(buffer)
 
 
-def decode(type_name: str, payloads: Sequence[bytes]) -> dict[str, NDArray] | None:
-    """Every field of ``payloads`` (n CDR messages of ``type_name``) as arrays of shape (n,),
-    plus ``stamp_ns`` (int64, ns) for stamped types; None when they cannot be read in bulk."""
-    if type_name not in _FIELDS or not payloads:
+def decode(type_name: str, payloads: Sequence[bytes] | NDArray[np.uint8]) -> dict[str, NDArray] | None:
+    """Every field of ``payloads`` (n CDR messages of ``type_name``, or an (n, L) uint8 array of
+    them, see ``Bag.rows``) as arrays of shape (n,), plus ``stamp_ns`` (int64, ns) for stamped
+    types; None when they cannot be read in bulk."""
+    if type_name not in _FIELDS or not len(payloads):
         return None
-    length = len(payloads[0])
-    if any(len(p) != length for p in payloads):
-        return None  # frame ids of different lengths
+    if isinstance(payloads, np.ndarray):
+        head = np.ascontiguousarray(payloads, dtype=np.uint8)
+        length = head.shape[1]
+    else:
+        length = len(payloads[0])
+        if any(len(p) != length for p in payloads):
+            return None  # frame ids of different lengths
+        head = np.frombuffer(b"".join(payloads), np.uint8).reshape(len(payloads), length)
     stamped = _FIELDS[type_name][0]
     if length < (_HEADER + 12 if stamped else _HEADER):
         return None
-    buffer = b"".join(payloads)
-    head = np.frombuffer(buffer, np.uint8).reshape(len(payloads), length)
     if np.any(head[:, :_HEADER] != np.frombuffer(_ENCAPSULATION, np.uint8)):
         return None  # big endian or XCDR2: rclpy reads those
     frame = int(head[0, _HEADER + 8 : _HEADER + 12].view("<u4")[0]) - 1 if stamped else 0
@@ -151,7 +155,7 @@ def decode(type_name: str, payloads: Sequence[bytes]) -> dict[str, NDArray] | No
     layout = _layout(type_name, frame)
     if layout.itemsize != length:
         return None
-    records = np.frombuffer(buffer, layout)
+    records = head.view(layout).reshape(len(head))
     if stamped and np.any(records["frame_id.length"] != frame + 1):
         return None
     columns = {name: records[name].copy() for name, _ in _FIELDS[type_name][1]}
@@ -165,6 +169,16 @@ def encode(
 ) -> list[bytes]:
     """CDR payloads of ``type_name``, one per stamp (ns >= 0, shape (n,)), with the given
     field values (arrays of shape (n,) or scalars; fields not given are zero)."""
+    rows = encode_array(type_name, stamp_ns, frame_id, fields)
+    data, size = rows.tobytes(), rows.shape[1]
+    return [data[k : k + size] for k in range(0, len(data), size)]
+
+
+def encode_array(
+    type_name: str, stamp_ns: ArrayLike, frame_id: str, fields: Mapping[str, ArrayLike]
+) -> NDArray[np.uint8]:
+    """:func:`encode` as one (n, L) uint8 array: row k is the k-th payload (all of L bytes),
+    for writers that take columns (``io.mcap_bulk.write_columns``)."""
     stamps = np.asarray(stamp_ns, dtype=np.int64)
     frame = frame_id.encode()
     layout = _layout(type_name, len(frame))
@@ -181,6 +195,4 @@ def encode(
         if name not in known:
             raise KeyError(f"{type_name} has no field {name!r}")
         records[name] = values
-    size = layout.itemsize
-    data = records.tobytes()
-    return [data[k : k + size] for k in range(0, len(data), size)]
+    return records.view(np.uint8).reshape(stamps.shape[0], layout.itemsize)
