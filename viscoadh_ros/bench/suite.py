@@ -9,7 +9,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-SECTIONS = ("kernel", "accuracy", "node", "replay")
+SECTIONS = ("kernel", "accuracy", "node", "replay", "gripper")
 #: The results keys each section writes (the soak is asked for by --soak, not --sections); a
 #: merge replaces exactly these.
 SECTION_KEYS = {
@@ -17,6 +17,7 @@ SECTION_KEYS = {
     "accuracy": ("accuracy", "presets"),
     "node": ("node", "startup_s"),
     "replay": ("replay",),
+    "gripper": ("gripper",),
     "soak": ("soak",),
 }
 #: Top-level keys that describe the run the report header names.
@@ -41,6 +42,9 @@ class Plan:
     node_duration_s: float
     replay_seconds: float
     replay_repeats: int
+    gripper_pads: tuple[int, ...]
+    gripper_seconds: float
+    gripper_repeats: int
 
 
 FULL = Plan(
@@ -58,6 +62,9 @@ FULL = Plan(
     node_duration_s=30.0,
     replay_seconds=60.0,
     replay_repeats=3,
+    gripper_pads=(1, 4, 16),
+    gripper_seconds=0.6,
+    gripper_repeats=3,
 )
 QUICK = Plan(
     kernel_elements=(64, 256, 1024, 4096),
@@ -74,6 +81,9 @@ QUICK = Plan(
     node_duration_s=5.0,
     replay_seconds=10.0,
     replay_repeats=1,
+    gripper_pads=(1, 4, 16),
+    gripper_seconds=0.3,
+    gripper_repeats=1,
 )
 
 
@@ -149,6 +159,13 @@ def run(
 
         progress(f"replay: {plan.replay_seconds:g} s of 1 kHz commands")
         results["replay"] = replay_benchmark(seconds=plan.replay_seconds, repeats=plan.replay_repeats)
+    if "gripper" in sections:
+        from viscoadh_ros.bench.gripper import gripper_benchmark
+
+        progress(f"gripper: {plan.gripper_seconds:g} s of the MuJoCo cell, library then node")
+        results["gripper"] = gripper_benchmark(
+            pads=plan.gripper_pads, seconds=plan.gripper_seconds, repeats=plan.gripper_repeats
+        )
     if soak_minutes is not None:
         from viscoadh_ros.bench.soak import soak
 

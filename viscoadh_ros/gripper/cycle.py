@@ -120,6 +120,7 @@ def run_cycle(
     *,
     choose_retract_speed: Callable[[PadBank], float] | None = None,
     stop_after_release: bool = False,
+    duration: float | None = None,
 ) -> Trajectory:
     """Run ``motion`` in a fresh MuJoCo model of ``cell`` with ``bank`` stepping the pads.
 
@@ -133,7 +134,8 @@ def run_cycle(
 
     ``choose_retract_speed(bank)`` is called once when the retraction of a place starts (if
     ``motion.retract_speed`` is None). ``stop_after_release``: end 20 steps after the release
-    (tests). InputError for a motion the coupling cannot resolve (`check_stability`).
+    (tests). ``duration``: end after this much simulated time, s (the bench). InputError for a
+    motion the coupling cannot resolve (`check_stability`).
     """
     check_stability(cell, motion)
     if bank.count != cell.gripper.pad_count:
@@ -157,6 +159,8 @@ def run_cycle(
     while True:
         t = step_time(step, dt_ns)
         if t > program.duration or (stop_at is not None and step >= stop_at):
+            break
+        if duration is not None and t > duration:
             break
         mujoco.mj_step1(m, d)
         geometry = world.pad_geometry()
