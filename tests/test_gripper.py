@@ -182,3 +182,47 @@ def test_cli_bad_cell_is_one_line_and_exit_2(tmp_path):
 def test_motion_rejects_a_negative_hold():
     with pytest.raises(InputError, match="hold_time must be a finite number >= 0"):
         Motion(hold_time=-1.0).validated()
+
+
+def _frames_run(tmp_path, backend):
+    env = {**__import__("os").environ, "MUJOCO_GL": backend}
+    return subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "viscoadh_ros",
+            "gripper",
+            "--scenario",
+            "transport",
+            "--frames",
+            str(tmp_path / "frames"),
+            "--out",
+            str(tmp_path / "out"),
+        ],
+        capture_output=True,
+        text=True,
+        check=False,
+        env=env,
+    )
+
+
+def test_frames_with_a_backend_that_is_not_offscreen_is_one_line_and_exit_2(tmp_path):
+    result = _frames_run(tmp_path, "glfw")
+    assert result.returncode == 2
+    assert result.stderr.strip().splitlines() == [
+        "viscoadh gripper: error: --frames: MUJOCO_GL='glfw': offscreen frames need 'egl' or 'osmesa'"
+    ]
+    assert not (tmp_path / "frames").exists()
+
+
+def test_frames_are_written_or_the_missing_backend_is_named(tmp_path):
+    # EGL works on this machine (frames written); where it does not, one line names it.
+    result = _frames_run(tmp_path, "egl")
+    if result.returncode == 0:
+        frames = sorted((tmp_path / "frames" / "transport").glob("*/frame_*.png"))
+        assert len(frames) > 5, result.stdout
+        assert frames[0].read_bytes()[:4] == b"\x89PNG"
+    else:
+        assert result.returncode == 2, result.stderr
+        (line,) = result.stderr.strip().splitlines()
+        assert line.startswith("viscoadh gripper: error: ") and "egl" in line

@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import argparse
 import csv
-from dataclasses import replace
 from pathlib import Path
 
 from viscoadh_ros.gripper import LibraryPads, Motion, default_cell_path, load_cell, run_cycle
@@ -36,6 +35,8 @@ def try_pick(cell, depth: float, hold: float):
     trajectory = run_cycle(cell, motion, LibraryPads(cell.pad, cell.gripper.pad_count))
     capacity = trajectory.predictions.get("pick_capacity_kg", 0.0)  # 0: the pad never touched
     return trajectory.success, capacity
+
+
 # --8<-- [end:pick]
 
 
@@ -54,6 +55,8 @@ def try_release(cell, holding_force: float, retract_speed: float = 0.002):
     trajectory = run_cycle(cell, motion, LibraryPads(cell.pad, 1), choose_retract_speed=decide)
     fixture_holds = holding_force + cell.gripper.part.mass * GRAVITY  # N the part resists with
     return trajectory.success, asked["pull_off"], fixture_holds
+
+
 # --8<-- [end:release]
 
 
@@ -70,8 +73,10 @@ def main() -> None:
                 held, capacity = try_pick(cell, depth, hold)
                 writer.writerow([depth, hold, capacity, int(held)])
                 verdict = "held" if held else "dropped"
-                print(f"press {depth * 1e6:5.0f} um, hold {hold:.2f} s: predicted capacity "
-                      f"{capacity * 1e3:.2f} g -> {verdict}")
+                print(
+                    f"press {depth * 1e6:5.0f} um, hold {hold:.2f} s: predicted capacity "
+                    f"{capacity * 1e3:.2f} g -> {verdict}"
+                )
     with open(args.out / "releases.csv", "w", newline="") as file:
         writer = csv.writer(file)
         writer.writerow(["holding_force_N", "predicted_pull_off_N", "fixture_holds_N", "released"])
@@ -79,8 +84,10 @@ def main() -> None:
             released, pull_off, holds = try_release(cell, force)
             writer.writerow([force, pull_off, holds, int(released)])
             verdict = "released" if released else "pulled out of the fixture"
-            print(f"latch {force * 1e3:g} mN: predicted pull-off {-pull_off * 1e3:.1f} mN, "
-                  f"fixture + weight {holds * 1e3:.1f} mN -> {verdict}")
+            print(
+                f"latch {force * 1e3:g} mN: predicted pull-off {-pull_off * 1e3:.1f} mN, "
+                f"fixture + weight {holds * 1e3:.1f} mN -> {verdict}"
+            )
 
 
 if __name__ == "__main__":

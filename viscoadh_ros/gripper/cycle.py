@@ -121,6 +121,7 @@ def run_cycle(
     choose_retract_speed: Callable[[PadBank], float] | None = None,
     stop_after_release: bool = False,
     duration: float | None = None,
+    frames: Callable[[mujoco.MjModel, mujoco.MjData, float], None] | None = None,
 ) -> Trajectory:
     """Run ``motion`` in a fresh MuJoCo model of ``cell`` with ``bank`` stepping the pads.
 
@@ -134,7 +135,8 @@ def run_cycle(
 
     ``choose_retract_speed(bank)`` is called once when the retraction of a place starts (if
     ``motion.retract_speed`` is None). ``stop_after_release``: end 20 steps after the release
-    (tests). ``duration``: end after this much simulated time, s (the bench). InputError for a
+    (tests). ``duration``: end after this much simulated time, s (the bench). ``frames(model, data, t)``:
+    called every step after the forces are applied (`render.FrameRecorder`). InputError for a
     motion the coupling cannot resolve (`check_stability`).
     """
     check_stability(cell, motion)
@@ -173,6 +175,8 @@ def run_cycle(
         world.apply_pad_forces(geometry, states.force)
         reference = program.arm_height(t)
         world.set_controls(reference, latch_closed=program.latch_fraction(t))
+        if frames is not None:
+            frames(m, d, t)
         rows["time"].append(t)
         rows["arm"].append(world.arm_height)
         rows["ref"].append(reference)

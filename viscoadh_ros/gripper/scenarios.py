@@ -56,7 +56,13 @@ class Run:
     trajectory: Trajectory
 
 
+#: Set by `viscoadh gripper --frames DIR`: a factory ``label -> frames callback`` for run_cycle.
+FRAMES: Callable[[str], Callable] | None = None
+
+
 def _run(label: str, cell: Cell, motion: Motion, bank: Bank, **kwargs) -> Run:
+    if FRAMES is not None:
+        kwargs["frames"] = FRAMES(label)
     pads = bank(cell)
     try:
         return Run(label, run_cycle(cell, motion, pads, **kwargs))
