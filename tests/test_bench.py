@@ -27,6 +27,8 @@ TINY = dataclasses.replace(
     reference_elements=32,
     reference_rows=101,
     preset_rows=51,
+    gripper_pads=(1,),
+    gripper_seconds=0.01,
 )
 
 
@@ -179,6 +181,23 @@ def test_sections_run_merges_into_the_existing_json(
     third = bench("kernel")
     assert len(third["kernel"]) == len(first["kernel"]), "a section is replaced, never appended"
     assert third["accuracy"] == second["accuracy"] and third["runs"]["accuracy"] == second["runs"]["accuracy"]
+
+
+def test_gripper_section_times_both_paths_and_renders(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    monkeypatch.setattr(suite, "QUICK", TINY)
+    json_path, output = tmp_path / "results.json", tmp_path / "BENCH.md"
+    argv = ["bench", "--quick", "--sections", "gripper", "--json", str(json_path), "--output", str(output)]
+    assert cli_main(argv) == 0, capsys.readouterr().err
+    (row,) = json.loads(json_path.read_text())["gripper"]
+    assert row["pads"] == 1 and row["steps"] == 51 and row["part_mass_kg"] == 1e-3
+    assert_finite_numbers(row, "gripper")
+    for path in ("library", "node"):
+        assert row[f"{path}_rtf"] == pytest.approx(row["sim_s"] / row[f"{path}_wall_s"])
+    text = output.read_text()
+    assert "## Gripper (MuJoCo cell)" in text
+    assert "| 1 | 1 | 0.0102 |" in text
 
 
 def test_merge_into_a_file_written_before_runs_existed() -> None:

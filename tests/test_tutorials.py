@@ -44,8 +44,8 @@ def region(path: Path, name: str) -> str:
     return textwrap.dedent(match.group(1))
 
 
-def test_there_are_three_tutorials():
-    assert [p.name[:2] for p in MARKDOWN] == ["01", "02", "03"], f"found {MARKDOWN}"
+def test_there_are_four_tutorials():
+    assert [p.name[:2] for p in MARKDOWN] == ["01", "02", "03", "04"], f"found {MARKDOWN}"
 
 
 @pytest.mark.parametrize("markdown", MARKDOWN, ids=lambda p: p.name)
@@ -138,3 +138,26 @@ def test_tutorial_3_lab_reaches_the_papers_slow_limit(tmp_path):
         err_msg="lab: fast pull without hold vs elastic JKR -(3/2) pi R w",
     )
     assert (tmp_path / "lab_out" / "pull_off.png").read_bytes()[:4] == b"\x89PNG"
+
+
+def test_tutorial_4_gripper_lab_picks_and_releases_as_predicted(tmp_path):
+    (output,) = run_blocks(TUTORIALS / "04_gripper_lab.md", tmp_path)
+    with open(tmp_path / "lab04_out" / "picks.csv") as file:
+        picks = [tuple(map(float, row)) for row in list(csv.reader(file))[1:]]
+    with open(tmp_path / "lab04_out" / "releases.csv") as file:
+        releases = [tuple(map(float, row)) for row in list(csv.reader(file))[1:]]
+    assert len(picks) == 4 and len(releases) == 2, output
+    mass = 1.3e-3
+    held = {(depth, hold): bool(ok) for depth, hold, _, ok in picks}
+    # A press held 0.3 s lifts the part, the same press without a hold does not (the lab's point).
+    assert held[(150e-6, 0.3)] and not held[(150e-6, 0.0)], output
+    for depth, hold, capacity, ok in picks:
+        # The stated margin: below the predicted capacity it holds, beyond 1.35 x it drops.
+        if mass < capacity:
+            assert ok, f"{depth} m, {hold} s: predicted {capacity} kg but dropped"
+        if mass > 1.35 * capacity:
+            assert not ok, f"{depth} m, {hold} s: predicted {capacity} kg but held"
+    for force, pull_off, fixture_holds, released in releases:
+        # The release succeeds exactly when the predicted pull-off stays below what holds the part.
+        assert bool(released) == (-pull_off < fixture_holds), f"latch {force} N: {output}"
+    assert {bool(r[3]) for r in releases} == {True, False}, "one latch too weak, one strong enough"

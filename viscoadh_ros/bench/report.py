@@ -310,6 +310,33 @@ def render_markdown(results: dict[str, Any], figure: Path | None, notes: str | N
             ],
         )
         lines += [""]
+    if "gripper" in results:
+        rows = results["gripper"]
+        lines += [
+            "## Gripper (MuJoCo cell)",
+            "",
+            "Real-time factor (simulated time / wall time; above 1 is faster than real time) of "
+            "`viscoadh gripper`'s cell: the start of the standard pick (approach, press, hold) at "
+            f"its {rows[0]['steps'] / rows[0]['sim_s']:.0f} Hz physics step, a part of 1 g per pad "
+            "(stable at that step), library path and node path (the in-process node over DDS, "
+            "lockstep on /clock) run alternately in one process.",
+            "",
+        ]
+        lines += _table(
+            ["pads", "part (g)", "simulated (s)", "library RTF", "node RTF", "library / node"],
+            [
+                [
+                    str(row["pads"]),
+                    f"{row['part_mass_kg'] * 1e3:g}",
+                    f"{row['sim_s']:.3g}",
+                    _g(row["library_rtf"]),
+                    _g(row["node_rtf"]),
+                    f"{row['library_rtf'] / row['node_rtf']:.0f}x",
+                ]
+                for row in rows
+            ],
+        )
+        lines += [""]
     if "soak" in results:
         soak = results["soak"]
         lines += [

@@ -9,7 +9,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-SECTIONS = ("kernel", "accuracy", "node", "replay", "batch")
+SECTIONS = ("kernel", "accuracy", "node", "replay", "batch", "gripper")
 #: The results keys each section writes (the soak is asked for by --soak, not --sections); a
 #: merge replaces exactly these.
 SECTION_KEYS = {
@@ -18,6 +18,7 @@ SECTION_KEYS = {
     "node": ("node", "startup_s"),
     "replay": ("replay",),
     "batch": ("batch",),
+    "gripper": ("gripper",),
     "soak": ("soak",),
 }
 #: Top-level keys that describe the run the report header names.
@@ -42,6 +43,9 @@ class Plan:
     node_duration_s: float
     replay_seconds: float
     replay_repeats: int
+    gripper_pads: tuple[int, ...]
+    gripper_seconds: float
+    gripper_repeats: int
     batch_bags: int = 12
     batch_seconds: float = 20.0
     batch_workers: tuple[int, ...] = (1, 2)
@@ -62,6 +66,9 @@ FULL = Plan(
     node_duration_s=30.0,
     replay_seconds=60.0,
     replay_repeats=3,
+    gripper_pads=(1, 4, 16),
+    gripper_seconds=0.6,
+    gripper_repeats=3,
 )
 QUICK = Plan(
     kernel_elements=(64, 256, 1024, 4096),
@@ -80,6 +87,9 @@ QUICK = Plan(
     replay_repeats=1,
     batch_bags=4,
     batch_seconds=2.0,
+    gripper_pads=(1, 4, 16),
+    gripper_seconds=0.3,
+    gripper_repeats=1,
 )
 
 
@@ -161,6 +171,13 @@ def run(
         progress(f"batch: {plan.batch_bags} bags of {plan.batch_seconds:g} s, workers {plan.batch_workers}")
         results["batch"] = batch_benchmark(
             bags=plan.batch_bags, seconds=plan.batch_seconds, workers=plan.batch_workers
+        )
+    if "gripper" in sections:
+        from viscoadh_ros.bench.gripper import gripper_benchmark
+
+        progress(f"gripper: {plan.gripper_seconds:g} s of the MuJoCo cell, library then node")
+        results["gripper"] = gripper_benchmark(
+            pads=plan.gripper_pads, seconds=plan.gripper_seconds, repeats=plan.gripper_repeats
         )
     if soak_minutes is not None:
         from viscoadh_ros.bench.soak import soak

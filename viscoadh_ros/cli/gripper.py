@@ -49,6 +49,20 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="step the pads through the viscoadh node over DDS (default: in process)",
     )
     parser.add_argument(
+        "--frames",
+        type=Path,
+        default=None,
+        metavar="DIR",
+        help="also render offscreen frames into DIR/<scenario>/<run>/frame_NNNNN.png; "
+        "MUJOCO_GL picks the backend: egl (default) or osmesa",
+    )
+    parser.add_argument(
+        "--fps",
+        type=float,
+        default=30.0,
+        help="frames per simulated second with --frames (default: 30)",
+    )
+    parser.add_argument(
         "--out",
         type=Path,
         default=DEFAULT_OUT,
@@ -59,8 +73,36 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def main(args: argparse.Namespace) -> int:
     """Run the scenarios, write one PNG each, print the outcomes; 2 for bad input."""
+    import os
+    import re
     from dataclasses import replace
 
+    recorders: list = []
+    if not args.fps > 0.0:
+        print(f"viscoadh gripper: error: --fps must be > 0 (got {args.fps:g})", file=sys.stderr)
+        return 2
+    if args.frames is not None:
+        # Before the first import of mujoco, which reads MUJOCO_GL.
+        backend = os.environ.setdefault("MUJOCO_GL", "egl").lower()
+        if backend not in ("egl", "osmesa"):
+            print(
+                f"viscoadh gripper: error: --frames: MUJOCO_GL={backend!r}: offscreen frames need "
+                "'egl' or 'osmesa'",
+                file=sys.stderr,
+            )
+            return 2
+    try:
+        import mujoco  # noqa: F401
+    except Exception as error:  # a MUJOCO_GL backend whose library is missing fails the import
+        gl = os.environ.get("MUJOCO_GL", "")
+        print(
+            f"viscoadh gripper: error: mujoco does not import with MUJOCO_GL={gl!r} "
+            f"({type(error).__name__}: {error}); install that backend's library (egl: libegl1, "
+            "osmesa: libosmesa6) or choose the other one",
+            file=sys.stderr,
+        )
+        return 2
+    from viscoadh_ros.gripper import render, scenarios
     from viscoadh_ros.gripper.config import default_cell_path, load_cell
     from viscoadh_ros.gripper.figures import plot_runs, plot_weights
     from viscoadh_ros.gripper.scenarios import RUNNERS, library_bank
@@ -79,10 +121,27 @@ def main(args: argparse.Namespace) -> int:
         bank = NodePads
     args.out.mkdir(parents=True, exist_ok=True)
     names = SCENARIO_NAMES if args.scenario == "all" else (args.scenario,)
+    scenario_name = ""
+    if args.frames is not None:
+
+        def recorder(label: str) -> render.FrameRecorder:
+            slug = re.sub(r"[^a-z0-9]+", "_", label.lower()).strip("_")
+            folder = args.frames / scenario_name / f"{len(recorders):02d}_{slug}"
+            recorders.append(render.FrameRecorder(folder, fps=args.fps))
+            return recorders[-1]
+
+        scenarios.FRAMES = recorder
     path_name = "node in the loop" if args.node else "library"
     for name in names:
+        scenario_name = name
         started = time.perf_counter()
-        runs = RUNNERS[name](cell, bank)
+        try:
+            runs = RUNNERS[name](cell, bank)
+        finally:
+            for recording in recorders:
+                recording.close()
+            if args.frames is not None and name == names[-1]:
+                scenarios.FRAMES = None
         wall = time.perf_counter() - started
         figure = args.out / f"gripper_{name}.png"
         if name == "weights":
@@ -94,4 +153,6 @@ def main(args: argparse.Namespace) -> int:
         print(f"{name} ({wall:.1f} s wall): {figure}")
         for run in runs:
             print(f"  {run.label.replace('|', ', ')}: {run.trajectory.outcome}")
+    if recorders:
+        print(f"frames: {sum(r.count for r in recorders)} PNGs under {args.frames}")
     return 0

@@ -120,12 +120,24 @@ def run_cycle(
     *,
     choose_retract_speed: Callable[[PadBank], float] | None = None,
     stop_after_release: bool = False,
+    duration: float | None = None,
+    frames: Callable[[mujoco.MjModel, mujoco.MjData, float], None] | None = None,
 ) -> Trajectory:
     """Run ``motion`` in a fresh MuJoCo model of ``cell`` with ``bank`` stepping the pads.
 
+    The pick's prediction (``predictions["pick_pull_off"]``, N, and ``["pick_capacity_kg"]``):
+    when the press really ends (the first step after the hold at which the pads' summed depth
+    falls: the servo lags its reference, so without a hold the arm still presses into the
+    peel), the live pads are asked `PadBank.predict_pull_off` at the speed they are then pulled
+    at (`Motion.pad_retract_speed`); the heaviest part that pull-off lifts is the pull-off over
+    ``g + lift_acceleration`` (the peak load of a lift with a peel, measured within 2 %).
+    It is a lower bound: docs/gripper.md gives the measured boundary against it.
+
     ``choose_retract_speed(bank)`` is called once when the retraction of a place starts (if
     ``motion.retract_speed`` is None). ``stop_after_release``: end 20 steps after the release
-    (tests). InputError for a motion the coupling cannot resolve (`check_stability`).
+    (tests). ``duration``: end after this much simulated time, s (the bench). ``frames(model, data, t)``:
+    called every step after the forces are applied (`render.FrameRecorder`). InputError for a
+    motion the coupling cannot resolve (`check_stability`).
     """
     check_stability(cell, motion)
     if bank.count != cell.gripper.pad_count:
@@ -144,16 +156,27 @@ def run_cycle(
     }
     step = 0
     stop_at: int | None = None
+    previous_depth = -math.inf
+    pick_prediction: float | None = None
     while True:
         t = step_time(step, dt_ns)
         if t > program.duration or (stop_at is not None and step >= stop_at):
             break
+        if duration is not None and t > duration:
+            break
         mujoco.mj_step1(m, d)
         geometry = world.pad_geometry()
+        if pick_prediction is None and t >= program.starts["peel"]:
+            deepest = float(geometry.depth.sum())
+            if deepest < previous_depth:  # the press really ended at the last step
+                pick_prediction = float(bank.predict_pull_off(motion.pad_retract_speed).sum())
+            previous_depth = deepest
         states = bank.step(t, geometry.depth)
         world.apply_pad_forces(geometry, states.force)
         reference = program.arm_height(t)
         world.set_controls(reference, latch_closed=program.latch_fraction(t))
+        if frames is not None:
+            frames(m, d, t)
         rows["time"].append(t)
         rows["arm"].append(world.arm_height)
         rows["ref"].append(reference)
@@ -166,7 +189,7 @@ def run_cycle(
         if (
             stop_after_release
             and stop_at is None
-            and t >= program.starts["lift"]
+            and t >= program.starts["peel"]
             and not states.contact_radius.any()
         ):
             stop_at = step + 20
@@ -187,6 +210,9 @@ def run_cycle(
         pad_count=bank.count,
         place=motion.place,
     )
+    if pick_prediction is not None:
+        trajectory.predictions["pick_pull_off"] = pick_prediction
+        trajectory.predictions["pick_capacity_kg"] = -pick_prediction / (GRAVITY + motion.lift_acceleration)
     if program.retract_speed is not None:
         trajectory.predictions["retract_speed"] = float(program.retract_speed)
     judge(trajectory)
@@ -198,7 +224,7 @@ def judge(trajectory: Trajectory) -> None:
     tr = trajectory
     lifted = tr.part_rise > LIFT_THRESHOLD
     tr.pick_step = int(np.argmax(lifted)) if lifted.any() else None
-    after_hold = tr.time >= tr.starts["lift"]
+    after_hold = tr.time >= tr.starts["peel"]
     free = ~tr.contact_radius.any(axis=1) & after_hold
     tr.release_step = int(np.argmax(free)) if free.any() else None
     released = tr.release_step is not None

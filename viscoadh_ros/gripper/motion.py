@@ -5,7 +5,9 @@ presses the pads ``press_depth`` into the part, as far as the servo gets them). 
 follows the reference with its own stiffness, so the depth reached is slightly less.
 
 Segments, in order: ``approach`` (constant speed from the start height to ``-press_depth``),
-``hold``, ``lift`` (trapezoidal velocity: ``lift_acceleration`` up to ``lift_speed``, and down
+``hold``, ``peel`` (with a ``peel_speed``: a slow constant rise from ``-press_depth`` to
+``PEEL_CLEARANCE`` above the part's top, so the part leaves the table while the arm moves
+slowly), ``lift`` (trapezoidal velocity: ``lift_acceleration`` up to ``lift_speed``, and down
 again, to ``lift_height``), ``carry`` (held up); with ``place``: ``lower`` (trapezoidal, back to
 ``-place_depth``), ``latch`` (the fixture's latch closes over ``latch_time``, then settles for
 ``LATCH_SETTLE_TIME``), ``retract`` (constant ``retract_speed`` up to ``RETRACT_TRAVEL``), ``dwell``.
@@ -20,13 +22,18 @@ from dataclasses import dataclass
 from viscoadh_ros.core.errors import InputError, require_positive
 
 #: Segment names in the order they run.
-SEGMENTS = ("approach", "hold", "lift", "carry", "lower", "latch", "retract", "dwell")
+SEGMENTS = ("approach", "hold", "peel", "lift", "carry", "lower", "latch", "retract", "dwell")
 #: How long the arm dwells after the retraction, s.
 DWELL_TIME = 0.05
 #: How long the closed latch settles on the part before the retraction, s.
 LATCH_SETTLE_TIME = 0.2
 #: How far the retraction of a place goes up, m (a part pulled out rises with it).
 RETRACT_TRAVEL = 2.0e-3
+#: Where the peel ends, m above the part's resting top: past the servo's lag at the peel speed
+#: (kv v / kp, 10 um at 1 mm/s in the built-in cell), the pad's stretch under the part's weight
+#: (a few um) and the part's spring-back out of the table's soft contact (up to ~20 um), so
+#: the part is off the table before the arm accelerates.
+PEEL_CLEARANCE = 0.1e-3
 
 
 @dataclass(frozen=True)
@@ -34,8 +41,12 @@ class Motion:
     """A pick (and place) plan, SI units.
 
     press_depth: m (> 0) the arm's reference goes below the part's top; approach_speed: m/s;
-    hold_time: s (>= 0); lift_speed: m/s; lift_acceleration: m/s^2 (the transport's
-    acceleration: the pads carry m (g + a) while it lasts); lift_height: m; carry_time: s;
+    hold_time: s (>= 0); peel_speed: m/s of the slow rise that takes the part off the table
+    before the lift accelerates (None: no peel, the lift starts at once from the press, and the
+    arm, already moving when the pad's tension reaches the part's weight, jerks the part off
+    the table: a tension peak about twice the weight, docs/gripper.md); lift_speed: m/s;
+    lift_acceleration: m/s^2 (the transport's acceleration: the pads carry m (g + a) while it
+    lasts); lift_height: m; carry_time: s;
     place: lower the part back into the fixture, latch it and retract; place_depth: m the
     reference goes below the part's top when placing; retract_speed: m/s of the release
     (None: chosen at the latch by the controller passed to `ArmProgram`).
@@ -44,6 +55,7 @@ class Motion:
     press_depth: float = 150e-6
     approach_speed: float = 5e-3
     hold_time: float = 0.3
+    peel_speed: float | None = 1e-3
     lift_speed: float = 0.05
     lift_acceleration: float = 2.0
     lift_height: float = 0.01
@@ -62,7 +74,21 @@ class Motion:
                 raise InputError(f"{name} must be a finite number >= 0 (got {value!r})")
         if self.retract_speed is not None:
             require_positive("retract_speed", self.retract_speed)
+        if self.peel_speed is not None:
+            require_positive("peel_speed", self.peel_speed)
         return self
+
+    @property
+    def lift_start_height(self) -> float:
+        """Where the trapezoidal lift starts, m: the peel's end, or the press without a peel."""
+        return -self.press_depth if self.peel_speed is None else PEEL_CLEARANCE
+
+    @property
+    def pad_retract_speed(self) -> float:
+        """The speed the pads are pulled off the part while their tension builds up to the
+        part's weight, m/s: the peel's, or (no peel) about the lift's (the arm has not reached
+        ``lift_speed`` by then; this is the fastest it may be)."""
+        return self.lift_speed if self.peel_speed is None else self.peel_speed
 
 
 def _trapezoid(
@@ -112,10 +138,12 @@ class ArmProgram:
         self.retract_speed = motion.retract_speed
         m = motion
         approach = (start_height + m.press_depth) / m.approach_speed
-        lift, lift_height = _trapezoid(-m.press_depth, m.lift_height, m.lift_speed, m.lift_acceleration)
+        lift, lift_height = _trapezoid(m.lift_start_height, m.lift_height, m.lift_speed, m.lift_acceleration)
+        peel = 0.0 if m.peel_speed is None else (PEEL_CLEARANCE + m.press_depth) / m.peel_speed
         self._segments: list[tuple[str, float, Callable[[float], float]]] = [
             ("approach", approach, lambda t: start_height - m.approach_speed * t),
             ("hold", m.hold_time, lambda t: -m.press_depth),
+            ("peel", peel, lambda t: -m.press_depth + (m.peel_speed or 0.0) * t),
             ("lift", lift, lift_height),
             ("carry", m.carry_time, lambda t: m.lift_height),
         ]
