@@ -54,10 +54,6 @@ class NodePads:
         self.ids = pad_ids(self.count)
         self._stack = contextlib.ExitStack()
         self._node: Node | None = None
-        # Destroyed last: only after node_in_process has stopped its executor's thread, which
-        # may still be waiting on this node's handles (destroying it first raised InvalidHandle
-        # in that thread).
-        self._stack.callback(self._destroy_client)
         try:
             context, executor = self._stack.enter_context(
                 node_in_process(cell.pad_scene(), use_sim_time=True, publish_rate=NODE_PUBLISH_RATE)
@@ -145,11 +141,6 @@ class NodePads:
                 raise RuntimeError(f"{self.ids[i]}/predict_pull_off failed: {answer.message}")
             forces[i] = answer.pull_off_force
         return forces
-
-    def _destroy_client(self) -> None:
-        if self._node is not None:
-            self._node.destroy_node()
-            self._node = None
 
     def close(self) -> None:
         """Stop the node and its executor (idempotent)."""
