@@ -260,6 +260,15 @@ class _ClosedForm:
     def stored_energy(self, depth: float) -> float:
         return self._potential(depth, self.radius) + self.physics.work_of_adhesion * math.pi * self.radius**2
 
+    def energy_dissipated(self, energy_input: float, depth: float) -> float:
+        """Input minus the potential: exact on this path (zero along a branch, the jump's
+        loss at snap-in and pull-off), J."""
+        return (
+            energy_input
+            - self.stored_energy(depth)
+            + self.physics.work_of_adhesion * math.pi * self.radius * self.radius
+        )
+
     def edge_gaps(self, depth: float) -> tuple[float, float]:
         gap = self._gap(depth, self.radius)
         return gap, gap
@@ -308,14 +317,16 @@ class _TimeStepped:
         self.row: _kernels.Row | None = None
         self.radius = 0.0
         self.substeps = 0
-        # (depth m, stored energy J) of the state the last `advance` left, None once the
-        # state changed otherwise.
-        self._stored: tuple[float, float] | None = None
+        # Energy dissipated since the last reset, J: a running sum of the kernel's
+        # non-negative losses per step (so it never decreases).
+        self.dissipated = 0.0
         # Largest |wsum| (m) the last `advance` left, None once the state changed otherwise.
         self._memory_peak: float | None = None
 
     # -- the domain ---------------------------------------------------------------------
-    def _build_row(self, length: float, memory: np.ndarray | None) -> _kernels.Row:
+    def _build_row(
+        self, length: float, memory: np.ndarray | None, unit: np.ndarray | None = None
+    ) -> _kernels.Row:
         n = self.numerics.elements
         m = n * self.numerics.fine_factor + 1
         profile = self.physics.profile
@@ -345,6 +356,7 @@ class _TimeStepped:
             steady=self.steady,
             e0=self.physics.e0,
             c_crit=self.physics.c_crit,
+            wb=unit,
         )
 
     def _grow(self, depth: float) -> None:
@@ -355,8 +367,11 @@ class _TimeStepped:
         length = row.length * self.numerics.growth_factor
         if length > 1e6 * max(self.initial_length, 1e-300) and length > 1e3:
             raise InputError("the contact grows without bound (adhesion beats the profile's rise)")
-        memory = _kernels.remap_memory(row, self.radius, depth, row.elements, length)
-        self.row = self._build_row(length, memory)
+        reach = self.punch_radius if self.punch_radius is not None else math.inf
+        dx = min(length, reach) / row.elements
+        centres = np.asarray(self.physics.profile.g((np.arange(row.elements) + 0.5) * dx), dtype=np.float64)
+        memory, unit = _kernels.remap_memory(row, self.radius, row.elements, min(length, reach), centres)
+        self.row = self._build_row(length, memory, unit)
 
     def _ensure_row(self, depth: float) -> bool:
         """Create the row if the indenter may touch; False if the step is trivially free."""
@@ -400,7 +415,7 @@ class _TimeStepped:
         out = row.out
         self.radius = float(out[_kernels.OUT_RADIUS])
         self.substeps = int(out[_kernels.OUT_SUBSTEPS])
-        self._stored = (d1, float(out[_kernels.OUT_STORED]))
+        self.dissipated += float(out[_kernels.OUT_DISSIPATED])
         self._memory_peak = float(out[_kernels.OUT_MEMORY])
         return self.radius, float(out[_kernels.OUT_FORCE]), float(out[_kernels.OUT_WORK])
 
@@ -408,9 +423,10 @@ class _TimeStepped:
         self, sim: ContactSimulator, times: np.ndarray, depths: np.ndarray
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Advance through a depth history from ``sim``'s time and depth as `sim._trial`
-        then `advance` would row by row; returns per row (radius m, force N, work J, stored
-        energy J, edge gaps (n, 2) m: exterior, interior memory). Rows without a row (no
-        domain yet, or idle above the surface) cost nothing here either."""
+        then `advance` would row by row; returns per row (radius m, force N, work J, energy
+        dissipated since the last reset J, edge gaps (n, 2) m: exterior, interior memory).
+        Rows without a row (no domain yet, or idle above the surface) cost nothing here
+        either."""
         n = times.size
         rows = np.zeros((n, _kernels.ROW_SIZE))
         t_prev, d_prev = sim.time, sim._depth
@@ -435,6 +451,7 @@ class _TimeStepped:
             i, status = _kernels._advance_rows(
                 *row.kernel_args,
                 backup,
+                np.empty_like(row.wl),
                 radius,
                 t_prev,
                 d_prev,
@@ -453,29 +470,32 @@ class _TimeStepped:
                 t_prev, d_prev = float(times[i - 1]), float(depths[i - 1])
                 self.radius = radius
                 self.substeps = int(last[_kernels.OUT_SUBSTEPS])
-                self._stored = (d_prev, float(last[_kernels.OUT_STORED]))
                 self._memory_peak = float(last[_kernels.OUT_MEMORY])
             if status == _kernels.STATUS_IDLE:
                 self.drop_memory()
             elif status == _kernels.STATUS_GROW:
-                self.set_state((self.radius, row, row.wl.copy()))
                 self._grow(d_prev)
         out = rows[:, : _kernels.OUT_SIZE]
+        dissipated = self.dissipated + np.cumsum(out[:, _kernels.OUT_DISSIPATED])
+        self.dissipated = float(dissipated[-1])
         return (
             out[:, _kernels.OUT_RADIUS].copy(),
             out[:, _kernels.OUT_FORCE].copy(),
             out[:, _kernels.OUT_WORK].copy(),
-            out[:, _kernels.OUT_STORED].copy(),
+            dissipated,
             rows[:, _kernels.ROW_GAP_OUTSIDE :].copy(),
         )
 
     def stored_energy(self, depth: float) -> float:
+        """Elastic energy of all springs at `depth` (m), J (computed on demand)."""
         if self.row is None:
             return 0.0
-        # The kernel computed it at the end of the last advance (same state, same depth).
-        if self._stored is not None and self._stored[0] == depth:
-            return self._stored[1]
         return _kernels.stored_energy(self.row, self.radius, depth)
+
+    def energy_dissipated(self, energy_input: float, depth: float) -> float:
+        """Energy dissipated since the last reset, J: the running sum of the kernel's
+        non-negative per-step losses (viscous work and adhesion hysteresis)."""
+        return self.dissipated
 
     def edge_gaps(self, depth: float) -> tuple[float, float]:
         """h at the edge with the exterior and with the interior memory, m."""
@@ -498,32 +518,31 @@ class _TimeStepped:
     def drop_memory(self) -> None:
         """Forget a relaxed, out-of-contact state: the next contact sizes a fresh domain."""
         self.row = None
-        self._stored = None
         self._memory_peak = None
 
     def get_state(self) -> tuple:
         if self.row is None:
-            return (self.radius, None, None)
-        return (self.radius, self.row, self.row.wl.copy())
+            return (self.radius, None, None, None, self.dissipated)
+        return (self.radius, self.row, self.row.wl.copy(), self.row.wb.copy(), self.dissipated)
 
     def set_state(self, state: tuple) -> None:
-        radius, row, memory = state
+        radius, row, memory, unit, dissipated = state
         self.radius = radius
-        self._stored = None
+        self.dissipated = dissipated
         self._memory_peak = None
         if row is None:
             self.row = None
         elif row is self.row:
-            row.set_memory(memory)
+            row.set_memory(memory, unit)
         else:
             # A snapshot of another simulator (or of a replaced domain): never share the
             # mutable arrays of a row between simulators.
-            self.row = row.with_memory(memory)
+            self.row = row.with_memory(memory, unit)
 
     def reset(self) -> None:
         self.radius = 0.0
         self.row = None
-        self._stored = None
+        self.dissipated = 0.0
         self._memory_peak = None
 
 
@@ -702,7 +721,7 @@ class ContactSimulator:
         if t.size == 0:
             return _empty_columns()
         if isinstance(self._model, _TimeStepped):
-            radius, force, work, stored, gaps = self._model.advance_rows(self, t, d)
+            radius, force, work, dissipated, gaps = self._model.advance_rows(self, t, d)
         else:
             outputs = [self.step(float(ti), depth=float(di)) for ti, di in zip(t, d, strict=True)]
             return _columns(outputs)
@@ -729,7 +748,6 @@ class ContactSimulator:
             physics.e_relaxed * u * u / (2.0 * math.pi * np.where(in_contact, radius, 1.0)),
             0.0,
         )
-        dissipated = energy_input - stored + physics.work_of_adhesion * math.pi * radius * radius
         v_c1, v_c2 = physics.critical_speeds
         ok = (edge_speed == 0.0) | (np.abs(edge_speed) >= np.where(edge_speed > 0.0, v_c1, v_c2))
         columns = {
@@ -796,8 +814,7 @@ class ContactSimulator:
             else:
                 phase = Phase.STICKING
         edge_speed = (radius - r0) / dt if dt > 0.0 else 0.0
-        stored = self._model.stored_energy(depth)
-        dissipated = self._energy_input - stored + physics.work_of_adhesion * math.pi * radius * radius
+        dissipated = self._model.energy_dissipated(self._energy_input, depth)
         return StepOutput(
             time=time,
             depth=depth,
