@@ -92,7 +92,10 @@ def study(table: dict) -> str:
             run = simulate_history(case.contact(elements=elements), times, depth=depths)
             err = cc.errors(case, run.force, run.contact_radius, run.energy_dissipated, entry)
             series.append(max(err["pull_off"], err["indentation"], err["retraction"]))
-        orders = [math.log2(a / b) if a > 0 and b > 0 else float("nan") for a, b in zip(series, series[1:])]
+        orders = [
+            math.log2(a / b) if a > 0 and b > 0 else float("nan")
+            for a, b in zip(series, series[1:], strict=False)
+        ]
         unc = entry["uncertainty"]
         lines.append(
             f"| {case.name} | {case.regime} | {' / '.join(f'{unc[q]:.0e}' for q in QUANTITIES)} | "

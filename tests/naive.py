@@ -126,16 +126,23 @@ def _extrapolate(p: np.ndarray, idx: np.ndarray, values: np.ndarray, size: int) 
 def side_values(
     row: _kernels.Row, x: np.ndarray, values: np.ndarray, units: np.ndarray, lo: int, hi: int
 ) -> np.ndarray:
-    """`_kernels._w_side` vectorised: the memory ``A(x) - g(x) B(x)`` with A (node values
-    ``values + g_c units``) and B (``units``) interpolated over elements lo..hi."""
+    """`_kernels._w_side` vectorised: between centres of elements lo..hi the linear
+    interpolant of the elongations corrected by the profile's curvature times the
+    interpolated B, ``w_lin - (g - g_lin) B_lin``; beyond them A (``values + g_c units``)
+    and B extrapolated (`_extrapolate`) and ``w = A - g B``."""
     x = np.asarray(x, dtype=np.float64)
     if lo > hi:
         return np.zeros_like(x)
     idx = np.arange(lo, hi + 1)
     p = x / row.dx - 0.5
+    g = g_at(row, x)
     a_x = _extrapolate(p, idx, values[idx] + row.g_c[idx] * units[idx], values.size)
     b_x = _extrapolate(p, idx, units[idx], values.size)
-    return a_x - g_at(row, x) * b_x
+    outside = a_x - g * b_x
+    w_lin = np.interp(p, idx.astype(float), values[idx])
+    g_lin = np.interp(p, idx.astype(float), row.g_c[idx])
+    inside = w_lin - (g - g_lin) * b_x
+    return np.where((p > lo) & (p < hi), inside, outside)
 
 
 def gap(row: _kernels.Row, x: np.ndarray, depth: float, radius: float, interior: bool) -> np.ndarray:

@@ -203,6 +203,6 @@ def test_first_touch_block_skip_finds_the_first_touching_fine_point(
     touching = depth - row.gf - naive.side_values(row, x, row.wsum, row.bsum, 0, row.elements - 1) >= 0.0
     expected = int(np.argmax(touching)) if touching.any() else -1
     found = _kernels._first_touch(
-        depth, row.wsum, row.bsum, row.dx, row.g_c, row.gf, row.gmin, row.df, row.reach
+        depth, row.wsum, row.bsum, row.dx, row.g_c, row.gf, row.gmin, row.gmax, row.df, row.reach
     )
     assert found == expected, f"{chain} seed={seed} d={depth}: {found} != {expected}"

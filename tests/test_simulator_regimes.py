@@ -112,28 +112,35 @@ def test_force_control_pull_off_is_three_halves_pi_r_w_eff2() -> None:
     assert abs(held / limit - 1.0) < 5e-3, f"held {held:.6g} N, paper {limit:.6g} N"
 
 
-def test_indentation_branch_has_no_single_row_spikes() -> None:
-    """A blunt cone (half-angle 80 deg) pressed into a standard solid (tau = 1 s) over 1 s in
-    1000 rows: on the indentation branch no row's force leaves the mean of its neighbours by
-    more than 1 % of the pull-off force (the memory interpolation switched stencils when the
-    edge crossed a centre: 2.7 % before the fix)."""
+@pytest.mark.parametrize("tau", [0.1, 1.0])
+def test_indentation_branch_has_no_single_row_spikes(tau: float) -> None:
+    """A blunt cone (half-angle 80 deg) pressed into a standard solid over 1 s in 1000 rows on
+    one fixed grid (`numerics.domain_radius`, the fit's mode: no regridding, few elements
+    across the young contact): on the indentation branch no row's force departs from the
+    curve through its neighbours (the fourth difference, which cancels the curvature) by
+    more than 0.5 % of the pull-off force. Before the A/B memory: 25 % at tau = 1 s, as the
+    edge crossed the first centres."""
     c = one_contact(
         {"shape": "cone", "half_angle": math.radians(80.0)},
         glass_shear_modulus=G0,
         kelvin=(G1,),
-        viscosities=(1.0 * (G0 + G1),),
+        viscosities=(tau * (G0 + G1),),
         work=WORK,
-        numerics={"model": "time_stepped"},
+        numerics={"model": "time_stepped", "domain_radius": 3e-4},
     )
     depth_max = 2e-5 * math.cos(math.radians(80.0)) / math.cos(math.radians(85.0))
     depth = np.concatenate([np.linspace(-1e-7, depth_max, 1000), np.linspace(depth_max, -depth_max, 1001)])
     result = simulate_history(c, np.linspace(0.0, 1.0, depth.size), depth=depth)
     pull_off = abs(result.force.min())
-    rows = np.flatnonzero((result.phase == Phase.INDENTING) & (np.arange(depth.size) < 999))
-    rows = rows[rows > rows[0] + 2]
+    rows = np.flatnonzero((result.phase == Phase.INDENTING) & (np.arange(depth.size) < 997))
+    rows = rows[rows > rows[0] + 3]
     f = result.force
-    spike = np.abs(f[rows] - 0.5 * (f[rows - 1] + f[rows + 1])) / pull_off
-    assert spike.max() < 1e-2, f"row {rows[np.argmax(spike)]}: {spike.max():.2%} of the pull-off force"
+
+    def bend(i: np.ndarray) -> np.ndarray:
+        return f[i] - 0.5 * (f[i - 1] + f[i + 1])
+
+    spike = np.abs(bend(rows) - 0.5 * (bend(rows - 1) + bend(rows + 1))) / pull_off
+    assert spike.max() < 5e-3, f"row {rows[np.argmax(spike)]}: {spike.max():.2%} of the pull-off force"
 
 
 @pytest.mark.parametrize(("tau", "depth_dc"), [(1e-2, 5.0), (1.0, 30.0)])

@@ -83,7 +83,7 @@ _PSI_SERIES_LIMIT = 0.5
 #: Edge roots are bisected to this fraction of an element width.
 EDGE_TOLERANCE = 1e-12
 
-#: Fine points per block of the first-touch search (`_first_touch`, `Row.gmin`).
+#: Fine points per block of the first-touch search (`_first_touch`, `Row.gmin`, `Row.gmax`).
 TOUCH_BLOCK = 32
 
 
@@ -168,8 +168,14 @@ def _side_ab(x, values, units, lo, hi, dx, g_c):
     """``(A(x), B(x))`` from the elements lo..hi of one side of the edge.
 
     ``values`` are elongations at the centres (``wsum`` or one Kelvin column), ``units`` the
-    matching unit-input responses B; the node values of A are ``values + g_c units``. Both
-    are interpolated linearly between centres. Beyond its last element the interior
+    matching unit-input responses B; the node values of A are ``values + g_c units``.
+    Between two centres B is linear and the memory is ``w = w_lin - (g - g_lin) B_lin``
+    (returned as ``A = w_lin + g_lin B_lin``): the linear interpolant of w corrected by the
+    profile's curvature in proportion to how relaxed the chain is. That is exact for a
+    glassy (B = 0, w = 0) and a relaxed (B = kap, w = kap u) stretch of elements for any
+    profile, and second order where B varies smoothly. (Interpolating A itself would add
+    the cross term ``t (1 - t) dg dB``, first order and wrong where B is unresolved: a
+    freshly attached edge element of a fast-relaxing body, whose u is ~0 anyway.) Beyond its last element the interior
     extrapolates each linearly with the minmod of its last two slopes (a freshly attached
     last element cannot steer the slope into a detach/attach flip-flop); the exterior
     extrapolates linearly towards the edge from its first two elements (an element that
@@ -206,9 +212,11 @@ def _side_ab(x, values, units, lo, hi, dx, g_c):
     if i >= hi:
         i = hi - 1
     t = p - i
-    a_i = values[i] + g_c[i] * units[i]
-    a_j = values[i + 1] + g_c[i + 1] * units[i + 1]
-    return a_i + t * (a_j - a_i), units[i] + t * (units[i + 1] - units[i])
+    b_x = units[i] + t * (units[i + 1] - units[i])
+    # A = w_lin + g_lin B_lin (not A_lin): w = w_lin - (g - g_lin) B_lin, see the docstring.
+    w_x = values[i] + t * (values[i + 1] - values[i])
+    g_x = g_c[i] + t * (g_c[i + 1] - g_c[i])
+    return w_x + g_x * b_x, b_x
 
 
 @numba.njit(cache=True, nogil=True)
@@ -269,14 +277,14 @@ def _scan_out(x_start, d, wsum, bsum, lo, hi, dx, g_c, gf, df, c_crit, reach):
 
 
 @numba.njit(cache=True, nogil=True)
-def _first_touch(d, wsum, bsum, dx, g_c, gf, gmin, df, reach):
+def _first_touch(d, wsum, bsum, dx, g_c, gf, gmin, gmax, df, reach):
     """First fine point (index) where the surface with its memory reaches the indenter,
     ``d - g - w >= 0``, or -1 if none up to `reach`.
 
     Out of contact with memory left this test runs every step, so whole blocks of
-    `TOUCH_BLOCK` fine points are skipped when a lower bound of ``g + w = A + g (1 - B)``
-    over the block (`gmin` of the block, the least A and the extreme B its interpolation
-    uses) already rules out a touch; the first touching point found is the same as a
+    `TOUCH_BLOCK` fine points are skipped when a lower bound of ``g + w`` over the block
+    (from `gmin`/`gmax` of the block and the extreme node values its interpolation uses)
+    already rules out a touch; the first touching point found is the same as a
     point-by-point scan."""
     m = gf.shape[0]
     n = wsum.shape[0]
@@ -289,14 +297,29 @@ def _first_touch(d, wsum, bsum, dx, g_c, gf, gmin, df, reach):
         # side against the rounding of x/dx.
         i0 = max(int(j0 * df / dx - 0.5) - 1, 0)
         i1 = min(int((j1 - 1) * df / dx - 0.5) + 2, n - 1)
-        a_least = wsum[i0] + g_c[i0] * bsum[i0]
+        w_least = wsum[i0]
         b_least = bsum[i0]
         b_most = bsum[i0]
+        gc_least = g_c[i0]
+        gc_most = g_c[i0]
         for i in range(i0 + 1, i1 + 1):
-            a_least = min(a_least, wsum[i] + g_c[i] * bsum[i])
+            w_least = min(w_least, wsum[i])
             b_least = min(b_least, bsum[i])
             b_most = max(b_most, bsum[i])
-        lower = a_least + min(gmin[b] * (1.0 - b_most), gmin[b] * (1.0 - b_least))
+            gc_least = min(gc_least, g_c[i])
+            gc_most = max(gc_most, g_c[i])
+        # g + w = g (1 - B) + w_lin + g_lin B: each product at least its least corner.
+        lower = (
+            w_least
+            + min(
+                gmin[b] * (1.0 - b_most),
+                gmin[b] * (1.0 - b_least),
+                gmax[b] * (1.0 - b_most),
+                gmax[b] * (1.0 - b_least),
+            )
+            + min(gc_least * b_least, gc_least * b_most, gc_most * b_least, gc_most * b_most)
+        )
+        a_least = abs(w_least) + abs(gc_most)
         # Margin: the interpolated values may undershoot their end values by a rounding error.
         margin = 1e-12 * (abs(d) + abs(gmin[b]) + abs(a_least))
         if d - lower < -margin:
@@ -311,14 +334,14 @@ def _first_touch(d, wsum, bsum, dx, g_c, gf, gmin, df, reach):
 
 
 @numba.njit(cache=True, nogil=True)
-def _locate_edge(a, d, wsum, bsum, dx, g_c, gf, gmin, df, c_crit, reach):
+def _locate_edge(a, d, wsum, bsum, dx, g_c, gf, gmin, gmax, df, c_crit, reach):
     """Apply the energy criterion both ways at depth d. Returns (new radius, motion, grow)."""
     n = wsum.shape[0]
     n_in = _interior_count(a, dx, n)
     if a <= 0.0:
         # First touch needs the surface (with its memory) to reach the indenter somewhere;
         # the contact then covers the centre out to the attachment root.
-        j = _first_touch(d, wsum, bsum, dx, g_c, gf, gmin, df, reach)
+        j = _first_touch(d, wsum, bsum, dx, g_c, gf, gmin, gmax, df, reach)
         if j < 0:
             return 0.0, MOTION_NONE, False
         radius, grow = _scan_out(j * df, d, wsum, bsum, 0, n - 1, dx, g_c, gf, df, c_crit, reach)
@@ -385,8 +408,8 @@ def _deviation_integral(a, d, wsum, bsum, n_in, dx, g_c, gf, gint, df, kap):
     f_prev = wsum[0] - kap * (d - g_c[0])
     for i in range(1, n_in):
         f_i = wsum[i] - kap * (d - g_c[i])
-        a_mid = 0.5 * (wsum[i - 1] + g_c[i - 1] * bsum[i - 1] + wsum[i] + g_c[i] * bsum[i])
         b_mid = 0.5 * (bsum[i - 1] + bsum[i])
+        a_mid = 0.5 * (wsum[i - 1] + wsum[i]) + 0.5 * (g_c[i - 1] + g_c[i]) * b_mid
         g_mid = gf[per_cell * i] if on_grid else _g_at(i * dx, gf, df)
         f_mid = (a_mid - kap * d) - g_mid * (b_mid - kap)
         total += dx * (f_prev + 4.0 * f_mid + f_i) / 6.0
@@ -735,6 +758,7 @@ def _advance(
     gf,
     gint,
     gmin,
+    gmax,
     df,
     e0,
     c_crit,
@@ -777,7 +801,7 @@ def _advance(
     substeps = 0
     attempts = 0
     if dt <= 0.0:
-        new_a, motion, grow = _locate_edge(a, d1, wsum, bsum, dx, g_c, gf, gmin, df, c_crit, reach)
+        new_a, motion, grow = _locate_edge(a, d1, wsum, bsum, dx, g_c, gf, gmin, gmax, df, c_crit, reach)
         if grow:
             return STATUS_GROW
         # The elements that switch at a jump in depth switch at the new depth.
@@ -827,7 +851,7 @@ def _advance(
         _kelvin_update(
             wl, wsum, wb, bsum, diss, n_in, da, db, h, g_c, p, p_inv, lam, beta, rate, e_kelvin, dx
         )
-        new_a, sub_motion, grow = _locate_edge(a, db, wsum, bsum, dx, g_c, gf, gmin, df, c_crit, reach)
+        new_a, sub_motion, grow = _locate_edge(a, db, wsum, bsum, dx, g_c, gf, gmin, gmax, df, c_crit, reach)
         if grow:
             return STATUS_GROW
         attempts += 1
@@ -897,6 +921,7 @@ def _advance_rows(
     gf,
     gint,
     gmin,
+    gmax,
     df,
     e0,
     c_crit,
@@ -956,6 +981,7 @@ def _advance_rows(
             gf,
             gint,
             gmin,
+            gmax,
             df,
             e0,
             c_crit,
@@ -1188,6 +1214,7 @@ class Row:
         self.kap = float(steady.sum())
         # Least profile height per block of TOUCH_BLOCK fine points (`_first_touch`).
         self.gmin = np.minimum.reduceat(gf, np.arange(0, m, TOUCH_BLOCK))
+        self.gmax = np.maximum.reduceat(gf, np.arange(0, m, TOUCH_BLOCK))
         self.out = np.zeros(OUT_SIZE)
 
     @property
@@ -1207,6 +1234,7 @@ class Row:
             self.gf,
             self.gint,
             self.gmin,
+            self.gmax,
             self.df,
             self.e0,
             self.c_crit,
@@ -1324,6 +1352,7 @@ def locate_edge(row: Row, radius: float, depth: float) -> tuple[float, int, bool
         row.g_c,
         row.gf,
         row.gmin,
+        row.gmax,
         row.df,
         row.c_crit,
         row.reach,
