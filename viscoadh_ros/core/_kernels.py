@@ -175,11 +175,12 @@ def _side_ab(x, values, units, lo, hi, dx, g_c):
     glassy (B = 0, w = 0) and a relaxed (B = kap, w = kap u) stretch of elements for any
     profile, and second order where B varies smoothly. (Interpolating A itself would add
     the cross term ``t (1 - t) dg dB``, first order and wrong where B is unresolved: a
-    freshly attached edge element of a fast-relaxing body, whose u is ~0 anyway.) Beyond its last element the interior
-    extrapolates each linearly with the minmod of its last two slopes (a freshly attached
-    last element cannot steer the slope into a detach/attach flip-flop); the exterior
-    extrapolates linearly towards the edge from its first two elements (an element that
-    just let go then sits at the attachment threshold instead of above it). At the centre
+    freshly attached edge element of a fast-relaxing body, whose u is ~0 anyway.)
+    Beyond its last element the interior extrapolates A and B linearly with the minmod of
+    its last two slopes (a freshly attached last element cannot steer the slope into a
+    detach/attach flip-flop); the exterior extrapolates them linearly towards the edge from
+    its first two elements (an element that just let go then sits at the attachment
+    threshold instead of above it). At the centre
     (symmetry) and the far end (no memory) values are held.
     """
     if lo > hi:

@@ -113,6 +113,7 @@ class ModelValidity:
     ok: bool
     message: str
 
+
 _CLOSED_FORM_EXPONENT = {"sphere": 2.0, "cone": 1.0}
 
 
