@@ -8,6 +8,7 @@ a `_kernels.Row` for its arrays and constants and never modify it.
 from __future__ import annotations
 
 import numpy as np
+from scipy.integrate import solve_ivp
 from scipy.linalg import expm
 
 from viscoadh_ros.core import _kernels
@@ -47,12 +48,55 @@ def chain_step(
     return (expm(m * dt) @ state)[:k]
 
 
-def kelvin_update(row: _kernels.Row, n_in: int, d0: float, d1: float, dt: float) -> np.ndarray:
-    """New Kelvin state (N, K) after dt: elements below n_in in contact, the rest free."""
+def kelvin_update(
+    row: _kernels.Row, n_in: int, d0: float, d1: float, dt: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """New Kelvin state (wl, wb), each (N, K), after dt: elements below n_in in contact, the
+    rest free. B is the same chain driven by a unit input."""
     out = row.wl.copy()
+    out_b = row.wb.copy()
     for i in range(row.elements):
         out[i] = chain_step(row.wl[i], d0 - row.g_c[i], d1 - row.g_c[i], dt, row, i < n_in)
-    return out
+        out_b[i] = chain_step(row.wb[i], 1.0, 1.0, dt, row, i < n_in)
+    return out, out_b
+
+
+def damper_work(row: _kernels.Row, n_in: int, d0: float, d1: float, dt: float) -> float:
+    """Energy the row's dampers dissipate over dt, J: ``2 dx sum_k eta_k* int (dl_k/dt)^2``
+    (both half-rows) integrated with the chain by a stiff ODE solver (Radau, tight
+    tolerances), element by element: elements below n_in in contact, the rest free."""
+    k = row.e_kelvin.size
+    if k == 0:
+        return 0.0
+    eta = row.e_kelvin / row.rate
+    total = 0.0
+    for i in range(row.elements):
+        inside = i < n_in
+        if inside:
+            a_mat = -(row.e0 * np.ones((k, k)) + np.diag(row.e_kelvin)) / eta[:, None]
+            b_vec = row.e0 / eta
+        else:
+            a_mat = -np.diag(row.rate)
+            b_vec = np.zeros(k)
+        u0 = d0 - row.g_c[i]
+        slope = (d1 - d0) / dt
+
+        def rhs(t, y, a_mat=a_mat, b_vec=b_vec, u0=u0, slope=slope):
+            rate = a_mat @ y[:k] + b_vec * (u0 + slope * t)
+            return np.concatenate([rate, [float(eta @ rate**2)]])
+
+        scale = max(float(np.max(np.abs(row.wl[i]))), abs(u0), 1e-12)
+        solution = solve_ivp(
+            rhs,
+            (0.0, dt),
+            np.concatenate([row.wl[i], [0.0]]),
+            method="Radau",
+            jac=lambda t, y, a_mat=a_mat: np.block([[a_mat, np.zeros((k, 1))], [np.zeros((1, k + 1))]]),
+            rtol=1e-9,
+            atol=1e-13 * scale,
+        )
+        total += 2.0 * row.dx * float(solution.y[k, -1])
+    return total
 
 
 def g_at(row: _kernels.Row, x: np.ndarray) -> np.ndarray:
@@ -60,29 +104,45 @@ def g_at(row: _kernels.Row, x: np.ndarray) -> np.ndarray:
     return np.interp(x, fine, row.gf)
 
 
+def _extrapolate(p: np.ndarray, idx: np.ndarray, values: np.ndarray, size: int) -> np.ndarray:
+    """Linear interpolation of node values over p (element index units), with the kernel's
+    one-sided extrapolations: linear below the first node (exterior towards the edge),
+    minmod-limited linear above the last (interior towards the edge), held at the centre
+    and the far end."""
+    lo, hi = int(idx[0]), int(idx[-1])
+    inside = np.interp(p, idx.astype(float), values)
+    if lo > 0 and hi > lo:
+        below = values[0] + (p - lo) * (values[1] - values[0])
+        inside = np.where(p <= lo, below, inside)
+    if hi < size - 1 and hi > lo:
+        slope = values[-1] - values[-2]
+        if hi - 2 >= lo:
+            before = values[-2] - values[-3]
+            slope = 0.0 if slope * before <= 0.0 else min(slope, before, key=abs)
+        inside = np.where(p >= hi, values[-1] + (p - hi) * slope, inside)
+    return inside
+
+
 def side_values(
-    row: _kernels.Row, x: np.ndarray, values: np.ndarray, lo: int, hi: int, coef: float, depth: float
+    row: _kernels.Row, x: np.ndarray, values: np.ndarray, units: np.ndarray, lo: int, hi: int
 ) -> np.ndarray:
-    """`_kernels._w_side` vectorised: interpolate ``values - coef u`` over elements lo..hi,
-    linear extrapolation below lo (exterior towards the edge), minmod-limited linear
-    extrapolation above hi (interior towards the edge), hold at the centre and far end."""
+    """`_kernels._w_side` vectorised: between centres of elements lo..hi the linear
+    interpolant of the elongations corrected by the profile's curvature times the
+    interpolated B, ``w_lin - (g - g_lin) B_lin``; beyond them A (``values + g_c units``)
+    and B extrapolated (`_extrapolate`) and ``w = A - g B``."""
     x = np.asarray(x, dtype=np.float64)
     if lo > hi:
         return np.zeros_like(x)
     idx = np.arange(lo, hi + 1)
-    dev = values[idx] - coef * (depth - row.g_c[idx])
     p = x / row.dx - 0.5
-    inside = np.interp(p, idx.astype(float), dev)
-    if lo > 0 and hi > lo:
-        below = dev[0] + (p - lo) * (dev[1] - dev[0])
-        inside = np.where(p <= lo, below, inside)
-    if hi < values.size - 1 and hi > lo:
-        slope = dev[-1] - dev[-2]
-        if hi - 2 >= lo:
-            before = dev[-2] - dev[-3]
-            slope = 0.0 if slope * before <= 0.0 else min(slope, before, key=abs)
-        inside = np.where(p >= hi, dev[-1] + (p - hi) * slope, inside)
-    return coef * (depth - g_at(row, x)) + inside
+    g = g_at(row, x)
+    a_x = _extrapolate(p, idx, values[idx] + row.g_c[idx] * units[idx], values.size)
+    b_x = _extrapolate(p, idx, units[idx], values.size)
+    outside = a_x - g * b_x
+    w_lin = np.interp(p, idx.astype(float), values[idx])
+    g_lin = np.interp(p, idx.astype(float), row.g_c[idx])
+    inside = w_lin - (g - g_lin) * b_x
+    return np.where((p > lo) & (p < hi), inside, outside)
 
 
 def gap(row: _kernels.Row, x: np.ndarray, depth: float, radius: float, interior: bool) -> np.ndarray:
@@ -90,7 +150,7 @@ def gap(row: _kernels.Row, x: np.ndarray, depth: float, radius: float, interior:
     n = row.elements
     n_in = interior_count(radius, row.dx, n)
     lo, hi = (0, n_in - 1) if interior else (n_in, n - 1)
-    w = side_values(row, x, row.wsum, lo, hi, row.kap if interior else 0.0, depth)
+    w = side_values(row, x, row.wsum, row.bsum, lo, hi)
     return depth - g_at(row, x) - w + row.c_crit * np.sqrt(x)
 
 
@@ -100,7 +160,7 @@ def force(row: _kernels.Row, radius: float, depth: float, points: int = 200001) 
         return 0.0
     x = np.linspace(0.0, radius, points)
     n_in = interior_count(radius, row.dx, row.elements)
-    w = side_values(row, x, row.wsum, 0, n_in - 1, row.kap, depth)
+    w = side_values(row, x, row.wsum, row.bsum, 0, n_in - 1)
     return 2.0 * row.e0 * trapezoid(depth - g_at(row, x) - w, x)
 
 
@@ -117,7 +177,7 @@ def stored_energy(row: _kernels.Row, radius: float, depth: float, points: int = 
         density = np.zeros_like(x)
         lsum = np.zeros_like(x)
         for k in range(row.e_kelvin.size):
-            lk = side_values(row, x, row.wl[:, k], lo, hi, row.steady[k] if interior else 0.0, depth)
+            lk = side_values(row, x, row.wl[:, k], row.wb[:, k], lo, hi)
             lsum += lk
             density += row.e_kelvin[k] * lk**2
         if interior:
@@ -135,7 +195,7 @@ def locate_edge(row: _kernels.Row, radius: float, depth: float, points: int = 40
     n = row.elements
     if radius <= 0.0:
         touching = np.flatnonzero(
-            depth - g_at(row, x) - side_values(row, x, row.wsum, 0, n - 1, 0.0, depth) >= 0.0
+            depth - g_at(row, x) - side_values(row, x, row.wsum, row.bsum, 0, n - 1) >= 0.0
         )
         if touching.size == 0:
             return 0.0

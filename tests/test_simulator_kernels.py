@@ -30,23 +30,40 @@ CHAINS = {
 
 
 def make_row(chain: str, *, work=0.05, length=2e-4, elements=24, seed=0) -> _kernels.Row:
-    """A row of the scene's simulator with random (reproducible) Kelvin memory."""
+    """A row of the scene's simulator with random (reproducible) Kelvin memory: elongations
+    and unit responses B (within their range [0, E_r*/E_k*])."""
     kelvin, viscosities = CHAINS[chain]
     sim = ContactSimulator(make_contact(kelvin=kelvin, viscosities=viscosities, work=work, elements=elements))
     rng = np.random.default_rng(seed)
     memory = rng.normal(scale=2e-6, size=(elements, len(kelvin)))
-    return sim._model._build_row(length, memory)
+    unit = rng.uniform(size=(elements, len(kelvin))) * sim._model.steady
+    return sim._model._build_row(length, memory, unit)
 
 
 @pytest.mark.parametrize("chain", list(CHAINS))
 @pytest.mark.parametrize("dt", [1e-6, 1e-2, 1.0, 1e4])
 def test_kelvin_update_matches_matrix_exponential(chain: str, dt: float) -> None:
     row = make_row(chain)
-    expected = naive.kelvin_update(row, 10, 3e-6, 5e-6, dt)
+    expected, expected_b = naive.kelvin_update(row, 10, 3e-6, 5e-6, dt)
     _kernels.kelvin_update(row, 10, 3e-6, 5e-6, dt)
     scale = max(float(np.max(np.abs(expected), initial=0.0)), 1e-12)
     np.testing.assert_allclose(row.wl, expected, rtol=1e-9, atol=1e-9 * scale, err_msg=f"{chain} dt={dt}")
     np.testing.assert_allclose(row.wsum, expected.sum(axis=1), rtol=1e-9, atol=1e-9 * scale, err_msg=chain)
+    np.testing.assert_allclose(row.wb, expected_b, rtol=1e-9, atol=1e-12, err_msg=f"B {chain} dt={dt}")
+
+
+@pytest.mark.parametrize("chain", ["standard", "three"])
+@pytest.mark.parametrize("dt", [1e-4, 1.0])
+@pytest.mark.parametrize("depths", [(3e-6, 5e-6)])
+def test_damper_work_is_the_energy_balance(chain: str, dt: float, depths: tuple[float, float]) -> None:
+    """The kernel's closed-form damper work over a step (the dissipation's viscous part)
+    equals the damper power integrated with the chain by a stiff ODE solver (three elements
+    in contact, three creeping back)."""
+    row = make_row(chain, elements=6)
+    expected = naive.damper_work(row, 3, *depths, dt)
+    got = _kernels.kelvin_update(row, 3, *depths, dt)
+    assert got >= 0.0
+    np.testing.assert_allclose(got, expected, rtol=1e-5, atol=1e-24, err_msg=f"{chain} dt={dt} {depths}")
 
 
 def test_phi_is_finite_and_exact_at_both_ends() -> None:
@@ -120,7 +137,7 @@ def test_detachment_wins_when_both_criteria_hold() -> None:
     memory = np.zeros_like(row.wl)
     memory[:n_in] = 4e-6  # crept interior: pushes its glass springs into tension
     memory[n_in:] = -4e-6  # exterior raised towards the indenter
-    row.set_memory(memory)
+    row.set_memory(memory, np.zeros_like(memory))
     assert _kernels.criterion_gap(row, radius, depth, radius, interior=True) < 0.0
     assert _kernels.criterion_gap(row, radius, depth, radius, interior=False) > 0.0
     new_radius, motion, _ = _kernels.locate_edge(row, radius, depth)
@@ -137,10 +154,11 @@ def test_advance_without_edge_motion_is_the_exact_chain_update() -> None:
     radius = 1.0e-4  # depth chosen so the (non-adhesive) edge stays within the cell
     depth = float(row.gf[int(radius / row.df)]) + 1e-9
     n_in = naive.interior_count(radius, row.dx, row.elements)
-    expected = naive.kelvin_update(row, n_in, depth, depth, 0.5)
+    expected, expected_b = naive.kelvin_update(row, n_in, depth, depth, 0.5)
     status, out = _kernels.advance(row, radius, depth, depth, 0.5, max_substep=0.0, max_edge_move=row.dx)
     assert status == _kernels.STATUS_OK
     np.testing.assert_allclose(row.wl, expected, rtol=1e-9, atol=1e-15, err_msg="chains")
+    np.testing.assert_allclose(row.wb, expected_b, rtol=1e-9, atol=1e-15, err_msg="unit responses")
     np.testing.assert_allclose(
         out[_kernels.OUT_FORCE],
         _kernels.force(row, out[_kernels.OUT_RADIUS], depth),
@@ -182,7 +200,9 @@ def test_first_touch_block_skip_finds_the_first_touching_fine_point(
     scan of ``d - g - w >= 0`` (exterior memory interpolated as `naive.side_values`)."""
     row = make_row(chain, seed=seed)
     x = np.arange(row.gf.shape[0]) * row.df
-    touching = depth - row.gf - naive.side_values(row, x, row.wsum, 0, row.elements - 1, 0.0, depth) >= 0.0
+    touching = depth - row.gf - naive.side_values(row, x, row.wsum, row.bsum, 0, row.elements - 1) >= 0.0
     expected = int(np.argmax(touching)) if touching.any() else -1
-    found = _kernels._first_touch(depth, row.wsum, row.dx, row.g_c, row.gf, row.gmin, row.df, row.reach)
+    found = _kernels._first_touch(
+        depth, row.wsum, row.bsum, row.dx, row.g_c, row.gf, row.gmin, row.gmax, row.df, row.reach
+    )
     assert found == expected, f"{chain} seed={seed} d={depth}: {found} != {expected}"

@@ -95,7 +95,8 @@ def test_adhesive_cycles_stay_finite_and_dissipative(
         assert np.all(np.isfinite(values.astype(np.float64))), f"{case}: {name} not finite"
     assert np.all(result.contact_radius >= 0.0), case
     energy_scale = max(np.abs(result.energy_input).max(), work * math.pi * result.contact_radius.max() ** 2)
-    assert result.energy_dissipated.min() >= -1e-3 * energy_scale - 1e-300, f"{case}: negative dissipation"
+    assert result.energy_dissipated.min() >= 0.0, f"{case}: negative dissipation"
+    assert np.all(np.diff(result.energy_dissipated) >= -1e-9 * energy_scale), f"{case}: dissipation decreases"
 
 
 def test_converges_as_elements_double() -> None:

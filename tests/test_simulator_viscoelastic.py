@@ -89,7 +89,7 @@ def test_quasistatic_cycle(kelvin, viscosities) -> None:
         atol=step,
         err_msg="end of the sticking zone",
     )
-    np.testing.assert_allclose(result.force.min(), -1.5 * math.pi * R * w2, rtol=2e-2, err_msg="pull-off")
+    np.testing.assert_allclose(result.force.min(), -1.5 * math.pi * R * w2, rtol=5e-3, err_msg="pull-off")
     assert result.contact_radius[-1] == 0.0
     assert np.all(result.energy_dissipated >= -1e-9 * result.energy_input.max()), "negative dissipation"
 

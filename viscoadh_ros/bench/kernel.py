@@ -112,14 +112,13 @@ def measure_kernel(elements: int, kelvin: int, *, steps: int, repeats: int) -> d
     row = model.row
     radius = model.radius
     numerics = simulator.numerics
-    wl0 = row.wl.copy()
+    wl0, wb0 = row.memory()
 
     max_substep = float(numerics.max_substep)
     max_edge_move = float(numerics.max_edge_cells * row.dx)
 
     def run_kernel() -> int:
-        row.wl[...] = wl0
-        row.wsum[...] = wl0.sum(axis=1)
+        row.set_memory(wl0, wb0)
         return _kernel_steps(row.kernel_args, radius, depth, STEP_S, max_substep, max_edge_move)
 
     def run_bare() -> None:

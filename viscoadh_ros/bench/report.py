@@ -18,6 +18,10 @@ SOAK_P99_DRIFT_TARGET = 0.10
 
 # What the stability property tests (tests/test_stability_*.py) cover; the bench does not run
 # them, the test suite does, so this table describes the suite rather than measuring it.
+#: Written by `python benchmarks/convergence.py` (minutes; not a `viscoadh bench` section):
+#: copied into BENCHMARKS.md as its last section.
+CONVERGENCE_REPORT = Path(__file__).resolve().parents[2] / "benchmarks" / "convergence.md"
+
 STABILITY_COVERAGE = (
     (
         "huge G0/G1 with tiny tau",
@@ -43,6 +47,11 @@ STABILITY_COVERAGE = (
         "convergence with refinement",
         "elements and steps halved",
         "pull-off force error shrinks toward the closed form",
+    ),
+    (
+        "every regime of a press and pull",
+        "creep times 1e-6..1e8 s against histories 1e-3..1e3 s, G0/G1 up to 1e4, 0.5..1000 d_c",
+        "finite output, lets go, dissipation >= 0 and never decreasing, pull-off within JKR bounds",
     ),
 )
 
@@ -359,4 +368,7 @@ def render_markdown(results: dict[str, Any], figure: Path | None, notes: str | N
         "",
     ]
     lines += _table(["extreme", "range", "checked"], [list(row) for row in STABILITY_COVERAGE])
+    if CONVERGENCE_REPORT.is_file():
+        lines += ["", "## Convergence against an independent reference", ""]
+        lines += [CONVERGENCE_REPORT.read_text(encoding="utf-8").strip()]
     return "\n".join(lines) + "\n"

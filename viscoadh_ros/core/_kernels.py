@@ -14,11 +14,27 @@ are in contact ("interior"; at least element 0 when ``a > 0``), the others are e
 
 State. ``wl[i, k]`` is the elongation of Kelvin element k of element i, m; ``wsum[i]``
 their sum. Interior glass elongation ``l0 = d - g(x) - wsum``, exterior ``l0 = 0``.
+The chain is linear in its input ``u_i(t) = d(t) - g(x_i)``, so its state splits exactly
+as ``wl_i = A_i - g(x_i) B_i``: ``A`` is the chain's response to ``d(t)`` and ``B``
+(``wb[i, k]``, sum ``bsum[i]``, dimensionless) its response to a unit input over the same
+in/out contact history. ``A`` and ``B`` depend on x only through the element's contact
+history (when it attached and let go), which is smooth in x, so the memory between
+element centres is ``w(x) = A(x) - g(x) B(x)`` with A and B interpolated linearly: exact
+for a glassy (A = B = 0) and a relaxed (A = kap d, B = kap) interior for ANY profile,
+second order in between. (Interpolating w itself carried the profile's curvature: a glassy
+sphere pressed deep pulled off several percent beyond JKR, issue 10.)
 
 Edge. ``h(x) = d - g(x) - w(x) + c sqrt(x)`` with ``c sqrt(x) = dl_c(x)``, the critical
-glass elongation. ``w(x)`` is interpolated linearly between element centres of ONE side
-(interior or exterior), held constant beyond that side's last centre: ``h`` is
-discontinuous at the edge, and that jump is the sticking zone.
+glass elongation. ``w(x)`` is taken from the elements of ONE side (interior or exterior),
+extrapolated beyond that side's last centre: ``h`` is discontinuous at the edge, and
+that jump is the sticking zone.
+
+Dissipation. Each step adds non-negative losses (`OUT_DISSIPATED`): the exact viscous
+work of every element's dampers over the step (modal form, for a depth linear in time,
+or the Kelvin energy an element out of contact loses by creeping back), plus the
+adhesion hysteresis of the elements that attach or let go within the step: an element of
+width dx attaching at glass elongation l0 (both half-rows hold ``E0* dx l0^2``) while its
+annulus gives up the surface energy ``2 pi x w dx = E0* c^2 x dx`` loses the difference.
 """
 
 from __future__ import annotations
@@ -43,7 +59,8 @@ OUT_FORCE = 1
 OUT_WORK = 2
 OUT_MOTION = 3
 OUT_SUBSTEPS = 4
-OUT_STORED = 5
+#: Energy dissipated over the step, J (>= 0: viscous work plus adhesion hysteresis).
+OUT_DISSIPATED = 5
 OUT_MEMORY = 6
 OUT_SIZE = 7
 
@@ -60,11 +77,13 @@ _MAX_ATTEMPTS = 2000
 # Below this |lambda dt| the phi functions use their Taylor series: the closed forms lose
 # all digits to cancellation there (1 - exp(-x) for x ~ 1e-12).
 _SERIES_LIMIT = 1e-4
+# Below this the dissipation integrals `_psi` use their (alternating, fast) series.
+_PSI_SERIES_LIMIT = 0.5
 
 #: Edge roots are bisected to this fraction of an element width.
 EDGE_TOLERANCE = 1e-12
 
-#: Fine points per block of the first-touch search (`_first_touch`, `Row.gmin`).
+#: Fine points per block of the first-touch search (`_first_touch`, `Row.gmin`, `Row.gmax`).
 TOUCH_BLOCK = 32
 
 
@@ -80,6 +99,35 @@ def _phi(x: float) -> tuple:
     e = math.exp(-x)
     one_minus = -math.expm1(-x)
     return e, one_minus / x, (x - one_minus) / (x * x)
+
+
+@numba.njit(cache=True, nogil=True)
+def _psi(x: float) -> tuple:
+    """Integrals for the damper work over a step of length h with ``x = lam h``, E = exp(-lam t),
+    F = (1 - E)/lam: ``(int E^2, int E F / h, int F^2 / h^2) / h`` =
+    ``(phi1(2x), (phi1(x) - phi1(2x))/x, (1 - 2 phi1(x) + phi1(2x))/x^2)``, x >= 0."""
+    if x < _PSI_SERIES_LIMIT:
+        # Term m of each: (-x)^m times 2^m/(m+1)!, (2^(m+1) - 1)/(m+2)!, (2^(m+2) - 2)/(m+3)!;
+        # 24 terms leave < 1e-18 for x < 0.5.
+        ee = 0.0
+        ef = 0.0
+        ff = 0.0
+        power = 1.0
+        two = 1.0
+        f1 = 1.0
+        for m in range(24):
+            f1 *= m + 1
+            f2 = f1 * (m + 2)
+            f3 = f2 * (m + 3)
+            ee += power * two / f1
+            ef += power * (2.0 * two - 1.0) / f2
+            ff += power * (4.0 * two - 2.0) / f3
+            power *= -x
+            two *= 2.0
+        return ee, ef, ff
+    e1, p1, _ = _phi(x)
+    e2, p2, _ = _phi(2.0 * x)
+    return p2, (p1 - p2) / x, (1.0 - 2.0 * p1 + p2) / (x * x)
 
 
 @numba.njit(cache=True, nogil=True)
@@ -109,59 +157,86 @@ def _g_at(x: float, gf: np.ndarray, df: float) -> float:
 
 
 @numba.njit(cache=True, nogil=True)
-def _w_side(x, values, lo, hi, dx, coef, d, g_c, gf, df):
-    """Memory at x from elements lo..hi (one side of the edge), m.
+def _minmod(slope: float, before: float) -> float:
+    if slope * before <= 0.0:
+        return 0.0
+    return slope if abs(slope) < abs(before) else before
 
-    The node values are split as ``values_i = coef * u_i + v_i`` with ``u = d - g`` and
-    ``coef`` the steady in-contact fraction (``1 - E_r*/E0*`` for the sum, ``E_r*/E_k*``
-    for Kelvin element k; 0 outside the contact): ``coef * u(x)`` is taken exactly and
-    only the deviation ``v`` is interpolated. Otherwise the force of a relaxed contact,
-    ``2 E0* int (u - w)``, would carry the interpolation error of w amplified by
-    ``E0*/E_r*`` (sign flips at G0/G1 = 1e3).
 
-    Beyond its last element the interior extrapolates its deviation linearly with the
-    minmod of its last two slopes: exact for a relaxed (v = 0) or glassy (v = -coef u)
-    interior, while a freshly attached last element cannot steer the slope into a
-    detach/attach flip-flop (a plain hold is first-order wrong for a glassy edge). The
-    exterior is extrapolated linearly towards the edge from its first two elements: an
-    element that just let go then sits at the attachment threshold instead of above it.
-    At the centre (symmetry) and the far end (no memory) values are held.
+@numba.njit(cache=True, nogil=True)
+def _side_ab(x, values, units, lo, hi, dx, g_c):
+    """``(A(x), B(x))`` from the elements lo..hi of one side of the edge.
+
+    ``values`` are elongations at the centres (``wsum`` or one Kelvin column), ``units`` the
+    matching unit-input responses B; the node values of A are ``values + g_c units``.
+    Between two centres B is linear and the memory is ``w = w_lin - (g - g_lin) B_lin``
+    (returned as ``A = w_lin + g_lin B_lin``): the linear interpolant of w corrected by the
+    profile's curvature in proportion to how relaxed the chain is. That is exact for a
+    glassy (B = 0, w = 0) and a relaxed (B = kap, w = kap u) stretch of elements for any
+    profile, and second order where B varies smoothly. (Interpolating A itself would add
+    the cross term ``t (1 - t) dg dB``, first order and wrong where B is unresolved: a
+    freshly attached edge element of a fast-relaxing body, whose u is ~0 anyway.)
+    Beyond its last element the interior extrapolates A and B linearly with the minmod of
+    its last two slopes (a freshly attached last element cannot steer the slope into a
+    detach/attach flip-flop); the exterior extrapolates them linearly towards the edge from
+    its first two elements (an element that just let go then sits at the attachment
+    threshold instead of above it). At the centre
+    (symmetry) and the far end (no memory) values are held.
     """
     if lo > hi:
-        return 0.0
-    base = coef * (d - _g_at(x, gf, df)) if coef != 0.0 else 0.0
+        return 0.0, 0.0
     p = x / dx - 0.5
+    n = values.shape[0]
     if p <= lo:
-        v_lo = values[lo] - coef * (d - g_c[lo])
+        a_lo = values[lo] + g_c[lo] * units[lo]
+        b_lo = units[lo]
         if lo == 0 or hi == lo:
-            return base + v_lo
-        v_next = values[lo + 1] - coef * (d - g_c[lo + 1])
-        return base + v_lo + (p - lo) * (v_next - v_lo)
+            return a_lo, b_lo
+        a_nx = values[lo + 1] + g_c[lo + 1] * units[lo + 1]
+        b_nx = units[lo + 1]
+        return a_lo + (p - lo) * (a_nx - a_lo), b_lo + (p - lo) * (b_nx - b_lo)
     if p >= hi:
-        v_hi = values[hi] - coef * (d - g_c[hi])
-        if hi == lo or hi == values.shape[0] - 1:
-            return base + v_hi
-        slope = v_hi - (values[hi - 1] - coef * (d - g_c[hi - 1]))
+        a_hi = values[hi] + g_c[hi] * units[hi]
+        b_hi = units[hi]
+        if hi == lo or hi == n - 1:
+            return a_hi, b_hi
+        a_pr = values[hi - 1] + g_c[hi - 1] * units[hi - 1]
+        b_pr = units[hi - 1]
+        slope_a = a_hi - a_pr
+        slope_b = b_hi - b_pr
         if hi - 2 >= lo:
-            # minmod limiter: a freshly attached last element must not steer the slope.
-            before = values[hi - 1] - coef * (d - g_c[hi - 1]) - (values[hi - 2] - coef * (d - g_c[hi - 2]))
-            slope = 0.0 if slope * before <= 0.0 else (slope if abs(slope) < abs(before) else before)
-        return base + v_hi + (p - hi) * slope
+            a_pp = values[hi - 2] + g_c[hi - 2] * units[hi - 2]
+            slope_a = _minmod(slope_a, a_pr - a_pp)
+            slope_b = _minmod(slope_b, b_pr - units[hi - 2])
+        return a_hi + (p - hi) * slope_a, b_hi + (p - hi) * slope_b
     i = int(p)
+    if i >= hi:
+        i = hi - 1
     t = p - i
-    v_i = values[i] - coef * (d - g_c[i])
-    v_j = values[i + 1] - coef * (d - g_c[i + 1])
-    return base + v_i + t * (v_j - v_i)
+    b_x = units[i] + t * (units[i + 1] - units[i])
+    # A = w_lin + g_lin B_lin (not A_lin): w = w_lin - (g - g_lin) B_lin, see the docstring.
+    w_x = values[i] + t * (values[i + 1] - values[i])
+    g_x = g_c[i] + t * (g_c[i + 1] - g_c[i])
+    return w_x + g_x * b_x, b_x
 
 
 @numba.njit(cache=True, nogil=True)
-def _h(x, d, wsum, lo, hi, dx, g_c, gf, df, c_crit, kap):
-    """Criterion gap h(x) with the memory of elements lo..hi; interior sides pass kap."""
-    return d - _g_at(x, gf, df) - _w_side(x, wsum, lo, hi, dx, kap, d, g_c, gf, df) + c_crit * math.sqrt(x)
+def _w_side(x, values, units, lo, hi, dx, g_c, gf, df):
+    """Memory ``w(x) = A(x) - g(x) B(x)`` at x from the elements lo..hi of one side, m."""
+    a_x, b_x = _side_ab(x, values, units, lo, hi, dx, g_c)
+    return a_x - _g_at(x, gf, df) * b_x
 
 
 @numba.njit(cache=True, nogil=True)
-def _bisect(x_lo, x_hi, d, wsum, lo, hi, dx, g_c, gf, df, c_crit, kap):
+def _h(x, d, wsum, bsum, lo, hi, dx, g_c, gf, df, c_crit):
+    """Criterion gap h(x) with the memory of elements lo..hi (one side of the edge)."""
+    g = _g_at(x, gf, df)
+    a_x, b_x = _side_ab(x, wsum, bsum, lo, hi, dx, g_c)
+    return d - g - (a_x - g * b_x) + c_crit * math.sqrt(x)
+
+
+@numba.njit(cache=True, nogil=True)
+def _bisect(x_lo, x_hi, d, wsum, bsum, lo, hi, dx, g_c, gf, df, c_crit):
     """Root of h between x_lo (h >= 0) and x_hi (h < 0), to ``EDGE_TOLERANCE * dx``: far
     below the discretisation error, and half the iterations of machine precision."""
     tol = EDGE_TOLERANCE * dx
@@ -169,7 +244,7 @@ def _bisect(x_lo, x_hi, d, wsum, lo, hi, dx, g_c, gf, df, c_crit, kap):
         mid = 0.5 * (x_lo + x_hi)
         if mid <= x_lo or mid >= x_hi or x_hi - x_lo <= tol:
             break
-        if _h(mid, d, wsum, lo, hi, dx, g_c, gf, df, c_crit, kap) >= 0.0:
+        if _h(mid, d, wsum, bsum, lo, hi, dx, g_c, gf, df, c_crit) >= 0.0:
             x_lo = mid
         else:
             x_hi = mid
@@ -177,7 +252,7 @@ def _bisect(x_lo, x_hi, d, wsum, lo, hi, dx, g_c, gf, df, c_crit, kap):
 
 
 @numba.njit(cache=True, nogil=True)
-def _scan_out(x_start, d, wsum, lo, hi, dx, g_c, gf, df, c_crit, reach):
+def _scan_out(x_start, d, wsum, bsum, lo, hi, dx, g_c, gf, df, c_crit, reach):
     """Outermost point of the h >= 0 run that starts at x_start (exterior memory): scan
     the fine grid outward.
 
@@ -192,25 +267,26 @@ def _scan_out(x_start, d, wsum, lo, hi, dx, g_c, gf, df, c_crit, reach):
         # A domain that ends at the reach (flat punch: L = a0) must not ask to grow
         # because the last fine point fell a rounding error short of it.
         if xj >= reach * (1.0 - 1e-12):
-            if _h(reach, d, wsum, lo, hi, dx, g_c, gf, df, c_crit, 0.0) >= 0.0:
+            if _h(reach, d, wsum, bsum, lo, hi, dx, g_c, gf, df, c_crit) >= 0.0:
                 return reach, False
-            return _bisect(prev, reach, d, wsum, lo, hi, dx, g_c, gf, df, c_crit, 0.0), False
-        if _h(xj, d, wsum, lo, hi, dx, g_c, gf, df, c_crit, 0.0) < 0.0:
-            return _bisect(prev, xj, d, wsum, lo, hi, dx, g_c, gf, df, c_crit, 0.0), False
+            return _bisect(prev, reach, d, wsum, bsum, lo, hi, dx, g_c, gf, df, c_crit), False
+        if _h(xj, d, wsum, bsum, lo, hi, dx, g_c, gf, df, c_crit) < 0.0:
+            return _bisect(prev, xj, d, wsum, bsum, lo, hi, dx, g_c, gf, df, c_crit), False
         prev = xj
         j += 1
     return prev, True
 
 
 @numba.njit(cache=True, nogil=True)
-def _first_touch(d, wsum, dx, g_c, gf, gmin, df, reach):
+def _first_touch(d, wsum, bsum, dx, g_c, gf, gmin, gmax, df, reach):
     """First fine point (index) where the surface with its memory reaches the indenter,
     ``d - g - w >= 0``, or -1 if none up to `reach`.
 
     Out of contact with memory left this test runs every step, so whole blocks of
     `TOUCH_BLOCK` fine points are skipped when a lower bound of ``g + w`` over the block
-    (`gmin` of the block, least memory value its interpolation uses) already rules out a
-    touch; the first touching point found is the same as a point-by-point scan."""
+    (from `gmin`/`gmax` of the block and the extreme node values its interpolation uses)
+    already rules out a touch; the first touching point found is the same as a
+    point-by-point scan."""
     m = gf.shape[0]
     n = wsum.shape[0]
     for b in range(gmin.shape[0]):
@@ -218,38 +294,58 @@ def _first_touch(d, wsum, dx, g_c, gf, gmin, df, reach):
         j1 = min(j0 + TOUCH_BLOCK, m)
         if j0 * df > reach:
             return -1
-        # The elements `_w_side` interpolates between over this block, widened by one each
+        # The elements `_side_ab` interpolates between over this block, widened by one each
         # side against the rounding of x/dx.
         i0 = max(int(j0 * df / dx - 0.5) - 1, 0)
         i1 = min(int((j1 - 1) * df / dx - 0.5) + 2, n - 1)
         w_least = wsum[i0]
+        b_least = bsum[i0]
+        b_most = bsum[i0]
+        gc_least = g_c[i0]
+        gc_most = g_c[i0]
         for i in range(i0 + 1, i1 + 1):
             w_least = min(w_least, wsum[i])
-        # Margin: the interpolated w may undershoot its end values by a rounding error.
-        margin = 1e-12 * (abs(d) + abs(gmin[b]) + abs(w_least))
-        if d - gmin[b] - w_least < -margin:
+            b_least = min(b_least, bsum[i])
+            b_most = max(b_most, bsum[i])
+            gc_least = min(gc_least, g_c[i])
+            gc_most = max(gc_most, g_c[i])
+        # g + w = g (1 - B) + w_lin + g_lin B: each product at least its least corner.
+        lower = (
+            w_least
+            + min(
+                gmin[b] * (1.0 - b_most),
+                gmin[b] * (1.0 - b_least),
+                gmax[b] * (1.0 - b_most),
+                gmax[b] * (1.0 - b_least),
+            )
+            + min(gc_least * b_least, gc_least * b_most, gc_most * b_least, gc_most * b_most)
+        )
+        a_least = abs(w_least) + abs(gc_most)
+        # Margin: the interpolated values may undershoot their end values by a rounding error.
+        margin = 1e-12 * (abs(d) + abs(gmin[b]) + abs(a_least))
+        if d - lower < -margin:
             continue
         for j in range(j0, j1):
             xj = j * df
             if xj > reach:
                 return -1
-            if d - gf[j] - _w_side(xj, wsum, 0, n - 1, dx, 0.0, d, g_c, gf, df) >= 0.0:
+            if d - gf[j] - _w_side(xj, wsum, bsum, 0, n - 1, dx, g_c, gf, df) >= 0.0:
                 return j
     return -1
 
 
 @numba.njit(cache=True, nogil=True)
-def _locate_edge(a, d, wsum, dx, g_c, gf, gmin, df, c_crit, reach, kap):
+def _locate_edge(a, d, wsum, bsum, dx, g_c, gf, gmin, gmax, df, c_crit, reach):
     """Apply the energy criterion both ways at depth d. Returns (new radius, motion, grow)."""
     n = wsum.shape[0]
     n_in = _interior_count(a, dx, n)
     if a <= 0.0:
         # First touch needs the surface (with its memory) to reach the indenter somewhere;
         # the contact then covers the centre out to the attachment root.
-        j = _first_touch(d, wsum, dx, g_c, gf, gmin, df, reach)
+        j = _first_touch(d, wsum, bsum, dx, g_c, gf, gmin, gmax, df, reach)
         if j < 0:
             return 0.0, MOTION_NONE, False
-        radius, grow = _scan_out(j * df, d, wsum, 0, n - 1, dx, g_c, gf, df, c_crit, reach)
+        radius, grow = _scan_out(j * df, d, wsum, bsum, 0, n - 1, dx, g_c, gf, df, c_crit, reach)
         if radius <= 0.0 and not grow:
             # Touching exactly at the apex without adhesion: no area, no contact.
             return 0.0, MOTION_NONE, False
@@ -258,52 +354,24 @@ def _locate_edge(a, d, wsum, dx, g_c, gf, gmin, df, c_crit, reach, kap):
     # first: an over-stretched interior edge cannot hold, whatever the memory outside says.
     # (Elements that just let go sit at the attachment threshold; the other order lets the
     # discretised exterior memory re-attach them and the receding edge chatter.)
-    if _h(a, d, wsum, 0, n_in - 1, dx, g_c, gf, df, c_crit, kap) < 0.0:
+    if _h(a, d, wsum, bsum, 0, n_in - 1, dx, g_c, gf, df, c_crit) < 0.0:
         j = int(a / df)
         if j * df >= a:
             j -= 1
         upper = a
         while j >= 0:
             xj = j * df
-            if _h(xj, d, wsum, 0, n_in - 1, dx, g_c, gf, df, c_crit, kap) >= 0.0:
-                radius = _bisect(xj, upper, d, wsum, 0, n_in - 1, dx, g_c, gf, df, c_crit, kap)
+            if _h(xj, d, wsum, bsum, 0, n_in - 1, dx, g_c, gf, df, c_crit) >= 0.0:
+                radius = _bisect(xj, upper, d, wsum, bsum, 0, n_in - 1, dx, g_c, gf, df, c_crit)
                 return radius, MOTION_DETACH, False
             upper = xj
             j -= 1
         return 0.0, MOTION_DETACH, False
     # Attachment of exterior elements, judged with the exterior (residual) memory.
-    if a < reach and _h(a, d, wsum, n_in, n - 1, dx, g_c, gf, df, c_crit, 0.0) > 0.0:
-        radius, grow = _scan_out(a, d, wsum, n_in, n - 1, dx, g_c, gf, df, c_crit, reach)
+    if a < reach and _h(a, d, wsum, bsum, n_in, n - 1, dx, g_c, gf, df, c_crit) > 0.0:
+        radius, grow = _scan_out(a, d, wsum, bsum, n_in, n - 1, dx, g_c, gf, df, c_crit, reach)
         return radius, MOTION_ATTACH, grow
     return a, MOTION_NONE, False
-
-
-@numba.njit(cache=True, nogil=True)
-def _deviation_integral(a, d, wsum, n_in, dx, g_c, gf, df, kap):
-    """Integral over (0, a) of the interpolated interior deviation v = w - kap u, m^2."""
-    if n_in == 0:
-        return 0.0
-    total = 0.0
-    x_prev = 0.0
-    v_prev = wsum[0] - kap * (d - g_c[0])
-    for i in range(n_in):
-        xi = (i + 0.5) * dx
-        if xi >= a:
-            break
-        v_i = wsum[i] - kap * (d - g_c[i])
-        if i == 0:
-            total += v_i * xi
-        else:
-            total += 0.5 * (v_prev + v_i) * (xi - x_prev)
-        x_prev = xi
-        v_prev = v_i
-    if a > x_prev:
-        if x_prev > 0.0:
-            v_edge = _w_side(a, wsum, 0, n_in - 1, dx, kap, d, g_c, gf, df) - kap * (d - _g_at(a, gf, df))
-            total += 0.5 * (v_prev + v_edge) * (a - x_prev)
-        else:
-            total += v_prev * a
-    return total
 
 
 @numba.njit(cache=True, nogil=True)
@@ -318,80 +386,221 @@ def _profile_integral(a, gf, gint, df):
 
 
 @numba.njit(cache=True, nogil=True)
-def _force(a, d, wsum, dx, g_c, gf, gint, df, e0, kap):
-    """Normal force ``F = 2 E0* int_0^a (u - w) dx = 2 E0* ((1-kap) int u - int v)``, N."""
+def _deviation_integral(a, d, wsum, bsum, n_in, dx, g_c, gf, gint, df, kap):
+    """Integral over (0, a) of the interior memory's deviation from relaxed,
+    ``dev = w - kap u = (A - kap d) - g (B - kap)``, m^2.
+
+    Below the first centre A and B are held: exact with the profile's integral. Between
+    centres (where ``dev = wsum - kap u`` at the nodes) and on the extrapolated piece up to
+    the edge A and B are linear: Simpson, exact for a paraboloid or a cone. The relaxed part
+    ``kap u`` is integrated exactly by the caller."""
+    if n_in == 0:
+        return 0.0
+    x0 = 0.5 * dx
+    first = a if a < x0 else x0
+    total = (wsum[0] + g_c[0] * bsum[0] - kap * d) * first - (bsum[0] - kap) * _profile_integral(
+        first, gf, gint, df
+    )
+    if a <= x0:
+        return total
+    m = gf.shape[0]
+    per_cell = (m - 1) // wsum.shape[0]
+    on_grid = per_cell * wsum.shape[0] == m - 1
+    f_prev = wsum[0] - kap * (d - g_c[0])
+    for i in range(1, n_in):
+        f_i = wsum[i] - kap * (d - g_c[i])
+        b_mid = 0.5 * (bsum[i - 1] + bsum[i])
+        a_mid = 0.5 * (wsum[i - 1] + wsum[i]) + 0.5 * (g_c[i - 1] + g_c[i]) * b_mid
+        g_mid = gf[per_cell * i] if on_grid else _g_at(i * dx, gf, df)
+        f_mid = (a_mid - kap * d) - g_mid * (b_mid - kap)
+        total += dx * (f_prev + 4.0 * f_mid + f_i) / 6.0
+        f_prev = f_i
+    x_last = (n_in - 0.5) * dx
+    if a > x_last:
+        mid = 0.5 * (x_last + a)
+        a_x, b_x = _side_ab(mid, wsum, bsum, 0, n_in - 1, dx, g_c)
+        f_mid = (a_x - kap * d) - _g_at(mid, gf, df) * (b_x - kap)
+        a_x, b_x = _side_ab(a, wsum, bsum, 0, n_in - 1, dx, g_c)
+        f_a = (a_x - kap * d) - _g_at(a, gf, df) * (b_x - kap)
+        total += (a - x_last) * (f_prev + 4.0 * f_mid + f_a) / 6.0
+    return total
+
+
+@numba.njit(cache=True, nogil=True)
+def _force(a, d, wsum, bsum, dx, g_c, gf, gint, df, e0, kap):
+    """Normal force ``F = 2 E0* int_0^a (u - w) dx = 2 E0* ((1-kap) int u - int dev)``, N,
+    with ``dev = w - kap u`` the memory's deviation from relaxed (zero when relaxed, so
+    the relaxed force carries no interpolation error amplified by E0*/E_r*)."""
     if a <= 0.0:
         return 0.0
     n_in = _interior_count(a, dx, wsum.shape[0])
     u_int = d * a - _profile_integral(a, gf, gint, df)
-    return 2.0 * e0 * ((1.0 - kap) * u_int - _deviation_integral(a, d, wsum, n_in, dx, g_c, gf, df, kap))
+    if kap == 0.0:
+        return 2.0 * e0 * u_int  # no Kelvin element: no memory
+    dev = _deviation_integral(a, d, wsum, bsum, n_in, dx, g_c, gf, gint, df, kap)
+    return 2.0 * e0 * ((1.0 - kap) * u_int - dev)
 
 
 @numba.njit(cache=True, nogil=True)
-def _contact_coefficients(lam, dt, e, phi1, chi):
-    """Per-mode coefficients of the exact linear-input update over dt (into e, phi1, chi)."""
+def _contact_coefficients(lam, dt, e, phi1, chi, cee, cef, cff):
+    """Per-mode coefficients of the exact linear-input update over dt (e, phi1, chi) and
+    of the damper work over it (cee, cef, cff; see `_chain_in_contact`)."""
     for m in range(lam.shape[0]):
-        em, f1, f2 = _phi(lam[m] * dt)
+        x = lam[m] * dt
+        em, f1, f2 = _phi(x)
         e[m] = em
         phi1[m] = f1 * dt
         chi[m] = f2 * dt
+        p_ee, p_ef, p_ff = _psi(x)
+        cee[m] = p_ee * dt
+        cef[m] = p_ef * dt * dt
+        cff[m] = p_ff * dt * dt * dt
 
 
 @numba.njit(cache=True, nogil=True)
-def _chain_in_contact(wl, wsum, i, u0, u1, p, p_inv, beta, e, phi1, chi, z):
-    """Element i in contact, total elongation u linear from u0 to u1 (coefficients given)."""
+def _chain_in_contact(
+    wl, wsum, wb, bsum, i, u0, u1, slope, p, p_inv, lam, beta, e, phi1, chi, cee, cef, cff, z, zb
+):
+    """Element i in contact over one interval, total elongation u linear from u0 to u1
+    (``slope`` = du/dt; coefficients from `_contact_coefficients` for its length).
+
+    Modes ``z = P l`` obey ``dz/dt = -lam z + beta u``; B the same with u = 1. Returns the
+    damper work of the element per unit width over the interval, ``sum_k eta_k int
+    (dl_k/dt)^2 = sum_m int (dz_m/dt)^2`` (P makes the damper metric the identity), with
+    ``dz/dt = zeta0 E(t) + beta slope F(t)``: a sum of non-negative terms (each term is the
+    integral of a square; rounding below zero is cut)."""
     k_count = wl.shape[1]
+    work = 0.0
     for m in range(k_count):
         acc = 0.0
+        acc_b = 0.0
         for k in range(k_count):
             acc += p[m, k] * wl[i, k]
+            acc_b += p[m, k] * wb[i, k]
         z[m] = e[m] * acc + beta[m] * (u0 * phi1[m] + (u1 - u0) * chi[m])
+        zb[m] = e[m] * acc_b + beta[m] * phi1[m]
+        zeta0 = beta[m] * u0 - lam[m] * acc
+        b = beta[m] * slope
+        q = zeta0 * zeta0 * cee[m] + 2.0 * zeta0 * b * cef[m] + b * b * cff[m]
+        if q > 0.0:
+            work += q
     total = 0.0
+    total_b = 0.0
     for k in range(k_count):
         acc = 0.0
+        acc_b = 0.0
         for m in range(k_count):
             acc += p_inv[k, m] * z[m]
+            acc_b += p_inv[k, m] * zb[m]
         wl[i, k] = acc
+        wb[i, k] = acc_b
         total += acc
+        total_b += acc_b
     wsum[i] = total
+    bsum[i] = total_b
+    return work
 
 
 @numba.njit(cache=True, nogil=True)
-def _chain_free(wl, wsum, i, decay):
-    """Element i out of contact: each Kelvin element creeps back by its factor `decay`."""
+def _chain_free(wl, wsum, wb, bsum, i, decay, e_kelvin):
+    """Element i out of contact: each Kelvin element creeps back by its factor `decay`.
+    Returns the Kelvin energy per unit width its dampers took, ``sum_k E_k (l^2 - l'^2)``."""
     total = 0.0
+    total_b = 0.0
+    lost = 0.0
     for k in range(wl.shape[1]):
-        wl[i, k] *= decay[k]
+        before = wl[i, k]
+        wl[i, k] = before * decay[k]
+        wb[i, k] *= decay[k]
+        lost += e_kelvin[k] * (before * before - wl[i, k] * wl[i, k])
         total += wl[i, k]
+        total_b += wb[i, k]
     wsum[i] = total
+    bsum[i] = total_b
+    return lost
 
 
 @numba.njit(cache=True, nogil=True)
-def _kelvin_update(wl, wsum, n_in, d0, d1, dt, g_c, p, p_inv, lam, beta, rate):
+def _kelvin_update(wl, wsum, wb, bsum, diss, n_in, d0, d1, dt, g_c, p, p_inv, lam, beta, rate, e_kelvin, dx):
     """Exact update of every Kelvin chain over dt for a depth linear from d0 to d1.
 
     Interior elements (i < n_in): modal form of ``dl/dt = A l + b u(t)``, ``u = d - g``.
-    Exterior elements: free creep-back ``dl_k/dt = -rate_k l_k``.
+    Exterior elements: free creep-back ``dl_k/dt = -rate_k l_k``. ``diss[i]`` gets the
+    energy element i dissipated, J (both half-rows: 2 dx times the damper work per width
+    for the glass-spring-driven chain, dx times the Kelvin energy lost creeping back).
     """
     n, k_count = wl.shape
     if k_count == 0 or dt <= 0.0:
+        for i in range(n):
+            diss[i] = 0.0
         return
     e = np.empty(k_count)
     phi1 = np.empty(k_count)
     chi = np.empty(k_count)
+    cee = np.empty(k_count)
+    cef = np.empty(k_count)
+    cff = np.empty(k_count)
     z = np.empty(k_count)
-    _contact_coefficients(lam, dt, e, phi1, chi)
+    zb = np.empty(k_count)
+    _contact_coefficients(lam, dt, e, phi1, chi, cee, cef, cff)
+    slope = (d1 - d0) / dt
     for i in range(n_in):
-        _chain_in_contact(wl, wsum, i, d0 - g_c[i], d1 - g_c[i], p, p_inv, beta, e, phi1, chi, z)
+        work = _chain_in_contact(
+            wl,
+            wsum,
+            wb,
+            bsum,
+            i,
+            d0 - g_c[i],
+            d1 - g_c[i],
+            slope,
+            p,
+            p_inv,
+            lam,
+            beta,
+            e,
+            phi1,
+            chi,
+            cee,
+            cef,
+            cff,
+            z,
+            zb,
+        )
+        diss[i] = 2.0 * dx * work
     for k in range(k_count):
         e[k] = math.exp(-rate[k] * dt)
     for i in range(n_in, n):
-        _chain_free(wl, wsum, i, e)
+        diss[i] = dx * _chain_free(wl, wsum, wb, bsum, i, e, e_kelvin)
 
 
 @numba.njit(cache=True, nogil=True)
-def _retime_crossed(wl, wsum, scratch, a0, a1, da, db, dt, dx, g_c, p, p_inv, lam, beta, rate):
-    """Redo the substep for the elements the edge crossed, switching them at the crossing.
+def _retime_crossed(
+    wl,
+    wsum,
+    wb,
+    bsum,
+    scratch,
+    scratch_b,
+    diss,
+    a0,
+    a1,
+    da,
+    db,
+    dt,
+    dx,
+    g_c,
+    p,
+    p_inv,
+    lam,
+    beta,
+    rate,
+    e_kelvin,
+    e0,
+    c_crit,
+):
+    """Redo the substep for the elements the edge crossed, switching them at the crossing;
+    returns their adhesion hysteresis, J (signed: the caller cuts a substep's sum at 0).
 
     `_kelvin_update` treats an element by its status at the substep's start. An element
     the edge passed during the substep really switched part-way: with the edge linear in
@@ -400,20 +609,26 @@ def _retime_crossed(wl, wsum, scratch, a0, a1, da, db, dt, dx, g_c, p, p_inv, la
     is off by about one cell of unrelaxed edge (1-2 % of the pull-off force at N ~ 100).
     Snap-in from no contact happens when the indenter touches: the switch time there is
     taken from the depth crossing zero (``f = -da/(db - da)``); a jump to no contact (the
-    fold) is taken at the substep's end.
+    fold) is taken at the substep's end. At the switch the element's glass spring takes
+    (attach) or gives up (let go) ``E0* dx l0^2`` while its annulus gives up or regains
+    the surface energy ``E0* c^2 x dx``: the difference is lost.
     """
     n, k_count = wl.shape
-    if k_count == 0 or dt <= 0.0:
-        return
     n0 = _interior_count(a0, dx, n)
     n1 = _interior_count(a1, dx, n)
     if n0 == n1:
-        return
+        return 0.0
     e = np.empty(k_count)
     phi1 = np.empty(k_count)
     chi = np.empty(k_count)
+    cee = np.empty(k_count)
+    cef = np.empty(k_count)
+    cff = np.empty(k_count)
     z = np.empty(k_count)
+    zb = np.empty(k_count)
     decay = np.empty(k_count)
+    slope = (db - da) / dt if dt > 0.0 else 0.0
+    hysteresis = 0.0
     lo, hi = (n0, n1) if n1 > n0 else (n1, n0)
     for i in range(lo, hi):
         xi = (i + 0.5) * dx
@@ -425,34 +640,126 @@ def _retime_crossed(wl, wsum, scratch, a0, a1, da, db, dt, dx, g_c, p, p_inv, la
             f = abs(xi - a0) / abs(a1 - a0)
         f = min(max(f, 0.0), 1.0)
         d_switch = da + f * (db - da)
+        total = 0.0
+        total_b = 0.0
         for k in range(k_count):
             wl[i, k] = scratch[i, k]
+            wb[i, k] = scratch_b[i, k]
+            total += wl[i, k]
+            total_b += wb[i, k]
+        wsum[i] = total
+        bsum[i] = total_b
+        first, second = f * dt, (1.0 - f) * dt
+        lost = 0.0
         if n1 > n0:
-            first, second = f * dt, (1.0 - f) * dt
             for k in range(k_count):
                 decay[k] = math.exp(-rate[k] * first)
-            _chain_free(wl, wsum, i, decay)
-            _contact_coefficients(lam, second, e, phi1, chi)
-            _chain_in_contact(wl, wsum, i, d_switch - g_c[i], db - g_c[i], p, p_inv, beta, e, phi1, chi, z)
+            lost += dx * _chain_free(wl, wsum, wb, bsum, i, decay, e_kelvin)
+            l0 = d_switch - g_c[i] - wsum[i]
+            hysteresis += e0 * dx * (c_crit * c_crit * xi - l0 * l0)
+            if k_count:
+                _contact_coefficients(lam, second, e, phi1, chi, cee, cef, cff)
+                lost += (
+                    2.0
+                    * dx
+                    * _chain_in_contact(
+                        wl,
+                        wsum,
+                        wb,
+                        bsum,
+                        i,
+                        d_switch - g_c[i],
+                        db - g_c[i],
+                        slope,
+                        p,
+                        p_inv,
+                        lam,
+                        beta,
+                        e,
+                        phi1,
+                        chi,
+                        cee,
+                        cef,
+                        cff,
+                        z,
+                        zb,
+                    )
+                )
         else:
-            first, second = f * dt, (1.0 - f) * dt
-            _contact_coefficients(lam, first, e, phi1, chi)
-            _chain_in_contact(wl, wsum, i, da - g_c[i], d_switch - g_c[i], p, p_inv, beta, e, phi1, chi, z)
+            if k_count:
+                _contact_coefficients(lam, first, e, phi1, chi, cee, cef, cff)
+                lost += (
+                    2.0
+                    * dx
+                    * _chain_in_contact(
+                        wl,
+                        wsum,
+                        wb,
+                        bsum,
+                        i,
+                        da - g_c[i],
+                        d_switch - g_c[i],
+                        slope,
+                        p,
+                        p_inv,
+                        lam,
+                        beta,
+                        e,
+                        phi1,
+                        chi,
+                        cee,
+                        cef,
+                        cff,
+                        z,
+                        zb,
+                    )
+                )
+            l0 = d_switch - g_c[i] - wsum[i]
+            hysteresis += e0 * dx * (l0 * l0 - c_crit * c_crit * xi)
             for k in range(k_count):
                 decay[k] = math.exp(-rate[k] * second)
-            _chain_free(wl, wsum, i, decay)
+            lost += dx * _chain_free(wl, wsum, wb, bsum, i, decay, e_kelvin)
+        diss[i] = lost
+    return hysteresis
+
+
+@numba.njit(cache=True, nogil=True)
+def _copy_state(src, src_b, dst, dst_b):
+    for i in range(src.shape[0]):
+        for k in range(src.shape[1]):
+            dst[i, k] = src[i, k]
+            dst_b[i, k] = src_b[i, k]
+
+
+@numba.njit(cache=True, nogil=True)
+def _restore_state(wl, wsum, wb, bsum, src, src_b):
+    for i in range(wl.shape[0]):
+        total = 0.0
+        total_b = 0.0
+        for k in range(wl.shape[1]):
+            wl[i, k] = src[i, k]
+            wb[i, k] = src_b[i, k]
+            total += wl[i, k]
+            total_b += wb[i, k]
+        wsum[i] = total
+        bsum[i] = total_b
 
 
 @numba.njit(cache=True, nogil=True)
 def _advance(
     wl,
     wsum,
+    wb,
+    bsum,
     scratch,
+    scratch_b,
+    diss,
     dx,
     g_c,
     gf,
     gint,
     gmin,
+    gmax,
     df,
     e0,
     c_crit,
@@ -464,7 +771,6 @@ def _advance(
     rate,
     kap,
     e_kelvin,
-    steady,
     out,
     a,
     d0,
@@ -481,31 +787,57 @@ def _advance(
     Substeps are halved while the edge would move more than ``max_edge_move`` (m) in one
     of them, down to ``1e-7 dt``: a true jump (snap-in, the fold at pull-off) is thereby
     located in time and crossed in one tiny substep that does no work. Writes radius,
-    force, work input, last motion, substep count, the stored energy at the end
-    (`_stored_energy`) and the largest |wsum| to ``out``: in the same compiled call, where
-    separate calls cost their dispatch. Returns STATUS_GROW
-    (state partly advanced: the caller restores) when the contact needs a larger domain.
+    force, work input, last motion, substep count, the energy dissipated over the step
+    (>= 0) and the largest |wsum| to ``out``. Returns STATUS_GROW (state partly advanced:
+    the caller restores) when the contact needs a larger domain.
     """
     n = wl.shape[0]
     h_min = dt * 1e-7
     step = dt if max_substep <= 0.0 or max_substep > dt else max_substep
     tau = 0.0
-    force_prev = _force(a, d0, wsum, dx, g_c, gf, gint, df, e0, kap)
+    force_prev = _force(a, d0, wsum, bsum, dx, g_c, gf, gint, df, e0, kap)
     work = 0.0
+    lost = 0.0
     motion = MOTION_NONE
     substeps = 0
     attempts = 0
     if dt <= 0.0:
-        new_a, motion, grow = _locate_edge(a, d1, wsum, dx, g_c, gf, gmin, df, c_crit, reach, kap)
+        new_a, motion, grow = _locate_edge(a, d1, wsum, bsum, dx, g_c, gf, gmin, gmax, df, c_crit, reach)
         if grow:
             return STATUS_GROW
-        force_new = _force(new_a, d1, wsum, dx, g_c, gf, gint, df, e0, kap)
+        # The elements that switch at a jump in depth switch at the new depth.
+        _copy_state(wl, wb, scratch, scratch_b)
+        hysteresis = _retime_crossed(
+            wl,
+            wsum,
+            wb,
+            bsum,
+            scratch,
+            scratch_b,
+            diss,
+            a,
+            new_a,
+            d1,
+            d1,
+            0.0,
+            dx,
+            g_c,
+            p,
+            p_inv,
+            lam,
+            beta,
+            rate,
+            e_kelvin,
+            e0,
+            c_crit,
+        )
+        force_new = _force(new_a, d1, wsum, bsum, dx, g_c, gf, gint, df, e0, kap)
         out[OUT_RADIUS] = new_a
         out[OUT_FORCE] = force_new
         out[OUT_WORK] = 0.5 * (force_prev + force_new) * (d1 - d0)
         out[OUT_MOTION] = motion
         out[OUT_SUBSTEPS] = 0
-        out[OUT_STORED] = _stored_energy(new_a, d1, wl, wsum, dx, g_c, gf, df, e0, e_kelvin, steady)
+        out[OUT_DISSIPATED] = max(hysteresis, 0.0)
         out[OUT_MEMORY] = _memory_peak(wsum)
         return STATUS_OK
     while tau < dt:
@@ -515,26 +847,49 @@ def _advance(
             h = dt - tau
         da = d0 + (d1 - d0) * (tau / dt)
         db = d1 if last else d0 + (d1 - d0) * ((tau + h) / dt)
-        for i in range(n):
-            for k in range(wl.shape[1]):
-                scratch[i, k] = wl[i, k]
+        _copy_state(wl, wb, scratch, scratch_b)
         n_in = _interior_count(a, dx, n)
-        _kelvin_update(wl, wsum, n_in, da, db, h, g_c, p, p_inv, lam, beta, rate)
-        new_a, sub_motion, grow = _locate_edge(a, db, wsum, dx, g_c, gf, gmin, df, c_crit, reach, kap)
+        _kelvin_update(
+            wl, wsum, wb, bsum, diss, n_in, da, db, h, g_c, p, p_inv, lam, beta, rate, e_kelvin, dx
+        )
+        new_a, sub_motion, grow = _locate_edge(a, db, wsum, bsum, dx, g_c, gf, gmin, gmax, df, c_crit, reach)
         if grow:
             return STATUS_GROW
         attempts += 1
         if abs(new_a - a) > max_edge_move and h > h_min and attempts < _MAX_ATTEMPTS:
-            for i in range(n):
-                total = 0.0
-                for k in range(wl.shape[1]):
-                    wl[i, k] = scratch[i, k]
-                    total += wl[i, k]
-                wsum[i] = total
+            _restore_state(wl, wsum, wb, bsum, scratch, scratch_b)
             step = 0.5 * h
             continue
-        _retime_crossed(wl, wsum, scratch, a, new_a, da, db, h, dx, g_c, p, p_inv, lam, beta, rate)
-        force_new = _force(new_a, db, wsum, dx, g_c, gf, gint, df, e0, kap)
+        hysteresis = _retime_crossed(
+            wl,
+            wsum,
+            wb,
+            bsum,
+            scratch,
+            scratch_b,
+            diss,
+            a,
+            new_a,
+            da,
+            db,
+            h,
+            dx,
+            g_c,
+            p,
+            p_inv,
+            lam,
+            beta,
+            rate,
+            e_kelvin,
+            e0,
+            c_crit,
+        )
+        viscous = 0.0
+        if wl.shape[1]:
+            for i in range(n):
+                viscous += diss[i]
+        lost += viscous + max(hysteresis, 0.0)
+        force_new = _force(new_a, db, wsum, bsum, dx, g_c, gf, gint, df, e0, kap)
         work += 0.5 * (force_prev + force_new) * (db - da)
         force_prev = force_new
         if sub_motion != MOTION_NONE:
@@ -548,7 +903,7 @@ def _advance(
     out[OUT_WORK] = work
     out[OUT_MOTION] = motion
     out[OUT_SUBSTEPS] = substeps
-    out[OUT_STORED] = _stored_energy(a, d1, wl, wsum, dx, g_c, gf, df, e0, e_kelvin, steady)
+    out[OUT_DISSIPATED] = lost
     out[OUT_MEMORY] = _memory_peak(wsum)
     return STATUS_OK
 
@@ -557,12 +912,17 @@ def _advance(
 def _advance_rows(
     wl,
     wsum,
+    wb,
+    bsum,
     scratch,
+    scratch_b,
+    diss,
     dx,
     g_c,
     gf,
     gint,
     gmin,
+    gmax,
     df,
     e0,
     c_crit,
@@ -574,9 +934,9 @@ def _advance_rows(
     rate,
     kap,
     e_kelvin,
-    steady,
     out,
     backup,
+    backup_b,
     a,
     t_prev,
     d_prev,
@@ -591,35 +951,38 @@ def _advance_rows(
 ):
     """`_advance` over rows ``first..`` of a depth history in one compiled loop.
 
-    Arguments: `Row.kernel_args`, ``backup`` (N, K) scratch for the memory before a row,
-    the state before row ``first`` (radius a, time, depth, largest |wsum| ``peak``), the
-    history ``times``/``depths`` (n,), the step's limits as `_advance` takes them and
-    ``idle_limit`` (m): a contact out of contact whose memory peak is within it is idle.
-    Row i of ``rows`` (n, ROW_SIZE) gets the ``out`` slots and the edge gaps with the
+    Arguments: `Row.kernel_args`, ``backup``/``backup_b`` (N, K) scratch for the memory
+    before a row, the state before row ``first`` (radius a, time, depth, largest |wsum|
+    ``peak``), the history ``times``/``depths`` (n,), the step's limits as `_advance` takes
+    them and ``idle_limit`` (m): a contact out of contact whose memory peak is within it is
+    idle. Row i of ``rows`` (n, ROW_SIZE) gets the ``out`` slots and the edge gaps with the
     exterior and the interior memory at the new radius (`criterion_gap`).
 
     Returns ``(i, status)``: all rows done (``i = n``, STATUS_OK), or stopped before row i
     with STATUS_IDLE (idle above the surface: the caller drops the memory, as
-    ContactSimulator does) or STATUS_GROW (memory restored, wsum not: the caller
-    restores it by its own rule, grows the domain and calls again from row i).
+    ContactSimulator does) or STATUS_GROW (memory restored: the caller grows the domain and
+    calls again from row i).
     """
     n = wl.shape[0]
     for i in range(first, times.shape[0]):
         d1 = depths[i]
         if a <= 0.0 and peak <= idle_limit and d1 < 0.0 and d_prev < 0.0:
             return i, STATUS_IDLE
-        for j in range(n):
-            for k in range(wl.shape[1]):
-                backup[j, k] = wl[j, k]
+        _copy_state(wl, wb, backup, backup_b)
         status = _advance(
             wl,
             wsum,
+            wb,
+            bsum,
             scratch,
+            scratch_b,
+            diss,
             dx,
             g_c,
             gf,
             gint,
             gmin,
+            gmax,
             df,
             e0,
             c_crit,
@@ -631,7 +994,6 @@ def _advance_rows(
             rate,
             kap,
             e_kelvin,
-            steady,
             out,
             a,
             d_prev,
@@ -641,9 +1003,7 @@ def _advance_rows(
             max_edge_move,
         )
         if status != STATUS_OK:
-            for j in range(n):
-                for k in range(wl.shape[1]):
-                    wl[j, k] = backup[j, k]
+            _restore_state(wl, wsum, wb, bsum, backup, backup_b)
             return i, status
         a = out[OUT_RADIUS]
         peak = out[OUT_MEMORY]
@@ -652,19 +1012,20 @@ def _advance_rows(
         if a > 0.0:
             # Only a contact's pinned edge needs them (the phase); none without contact.
             n_in = _interior_count(a, dx, n)
-            rows[i, ROW_GAP_OUTSIDE] = _h(a, d1, wsum, n_in, n - 1, dx, g_c, gf, df, c_crit, 0.0)
-            rows[i, ROW_GAP_INSIDE] = _h(a, d1, wsum, 0, n_in - 1, dx, g_c, gf, df, c_crit, kap)
+            rows[i, ROW_GAP_OUTSIDE] = _h(a, d1, wsum, bsum, n_in, n - 1, dx, g_c, gf, df, c_crit)
+            rows[i, ROW_GAP_INSIDE] = _h(a, d1, wsum, bsum, 0, n_in - 1, dx, g_c, gf, df, c_crit)
         t_prev = times[i]
         d_prev = d1
     return times.shape[0], STATUS_OK
 
 
 @numba.njit(cache=True, nogil=True)
-def _remap(wl, a, d, dx, g_c, gf, df, steady, new_dx, out):
-    """Kelvin state of a regridded row (element width new_dx) into ``out`` (N', K).
+def _remap(wl, wb, a, dx, g_c, new_dx, new_gc, out, out_b):
+    """Kelvin state of a regridded row (element width new_dx, profile new_gc at its
+    centres) into ``out``/``out_b`` (N', K).
 
-    Each new centre takes the memory of its own side of the edge, interpolated exactly as
-    the force and criterion see it (`_w_side`): interpolating across the edge would smear
+    Each new centre takes A and B of its own side of the edge, interpolated exactly as the
+    force and criterion see them (`_side_ab`): interpolating across the edge would smear
     the interior/exterior jump that is the sticking zone. Beyond the old domain nothing was
     ever touched: zero memory.
     """
@@ -678,50 +1039,25 @@ def _remap(wl, a, d, dx, g_c, gf, df, steady, new_dx, out):
         for k in range(k_count):
             if x > length:
                 out[i, k] = 0.0
+                out_b[i, k] = 0.0
             else:
-                coef = steady[k] if interior else 0.0
-                out[i, k] = _w_side(x, wl[:, k], lo, hi, dx, coef, d, g_c, gf, df)
+                a_x, b_x = _side_ab(x, wl[:, k], wb[:, k], lo, hi, dx, g_c)
+                out_b[i, k] = b_x
+                out[i, k] = a_x - new_gc[i] * b_x
 
 
 @numba.njit(cache=True, nogil=True)
-def _energy_density(x, d, interior, n_in, wl, wsum, dx, g_c, gf, df, e0, e_kelvin, steady):
-    """Spring energy per unit length at x, J/m: E0* l0^2 + sum_k E_k* l_k^2 (both half-rows).
-
-    Each l_k is interpolated like w (`_w_side`, steady fraction ``steady[k]`` inside), so
-    between two elements the interpolant is itself an exact chain trajectory and this
-    density does not grow under relaxation at fixed depth beyond O(dx^2).
-    """
+def _energy_density(x, d, interior, n_in, wl, wb, dx, g_c, gf, df, e0, e_kelvin):
+    """Spring energy per unit length at x, J/m: E0* l0^2 + sum_k E_k* l_k^2 (both half-rows),
+    each ``l_k = A_k - g B_k`` interpolated on its side of the edge like the memory."""
     n = wl.shape[0]
     lo, hi = (0, n_in - 1) if interior else (n_in, n - 1)
+    g = _g_at(x, gf, df)
     total = 0.0
     lsum = 0.0
     for k in range(wl.shape[1]):
-        coef = steady[k] if interior else 0.0
-        lk = _w_side(x, wl[:, k], lo, hi, dx, coef, d, g_c, gf, df)
-        lsum += lk
-        total += e_kelvin[k] * lk * lk
-    if interior:
-        l0 = d - _g_at(x, gf, df) - lsum
-        total += e0 * l0 * l0
-    return total
-
-
-@numba.njit(cache=True, nogil=True)
-def _node_density(g, d, interior, i0, i1, t, wl, g_c, e0, e_kelvin, steady):
-    """`_energy_density` at a point of profile height g between element centres i0 <= i1
-    of one side (t: the weight of i1), where the memory deviation is the plain linear
-    interpolation: the same values without `_w_side`'s branches (the stored energy is
-    evaluated every step)."""
-    total = 0.0
-    lsum = 0.0
-    for k in range(wl.shape[1]):
-        if interior:
-            coef = steady[k]
-            v0 = wl[i0, k] - coef * (d - g_c[i0])
-            v1 = wl[i1, k] - coef * (d - g_c[i1])
-            lk = coef * (d - g) + v0 + t * (v1 - v0)
-        else:
-            lk = wl[i0, k] + t * (wl[i1, k] - wl[i0, k])
+        a_x, b_x = _side_ab(x, wl[:, k], wb[:, k], lo, hi, dx, g_c)
+        lk = a_x - g * b_x
         lsum += lk
         total += e_kelvin[k] * lk * lk
     if interior:
@@ -731,42 +1067,27 @@ def _node_density(g, d, interior, i0, i1, t, wl, g_c, e0, e_kelvin, steady):
 
 
 @numba.njit(cache=True, nogil=True)
-def _side_energy(x0, x1, d, interior, n_in, wl, wsum, dx, g_c, gf, df, e0, e_kelvin, steady):
-    """Integral of `_energy_density` over (x0, x1) on one side of the edge, J: Simpson on
-    each piece between element centres, where the interpolated memory is linear (exact for
-    a paraboloid's quartic density, so a few points per element suffice). Pieces between
-    two centres of the side take `_node_density`; the end pieces (held or extrapolated
-    memory, cut by the edge) the general density."""
+def _side_energy(x0, x1, d, interior, n_in, wl, wb, dx, g_c, gf, df, e0, e_kelvin):
+    """Integral of `_energy_density` over (x0, x1) on one side of the edge, J: composite
+    Simpson (two panels) on each piece between element centres, where A and B are linear."""
     n = wl.shape[0]
-    lo, hi = (0, n_in - 1) if interior else (n_in, n - 1)
-    # When every centre and every midpoint between centres is a fine point (an even number
-    # of fine intervals per element, as the simulator builds rows), the profile there is
-    # read off the fine grid: `_g_at`'s two divisions per point were most of this loop.
-    per_cell = (gf.shape[0] - 1) // n
-    on_grid = per_cell * n == gf.shape[0] - 1 and per_cell % 2 == 0
     total = 0.0
     prev = x0
-    e_prev = _energy_density(prev, d, interior, n_in, wl, wsum, dx, g_c, gf, df, e0, e_kelvin, steady)
+    e_prev = _energy_density(prev, d, interior, n_in, wl, wb, dx, g_c, gf, df, e0, e_kelvin)
     for i in range(n + 1):
         xi = (i + 0.5) * dx if i < n else x1
         if xi <= x0:
             continue
         if xi > x1:
             xi = x1
-        mid = 0.5 * (prev + xi)
-        if i - 1 >= lo and i <= hi and xi == (i + 0.5) * dx and prev == (i - 0.5) * dx:
-            if on_grid:
-                g_mid = gf[per_cell * i]
-                g_i = gf[per_cell * i + per_cell // 2]
-            else:
-                g_mid = _g_at(mid, gf, df)
-                g_i = _g_at(xi, gf, df)
-            e_mid = _node_density(g_mid, d, interior, i - 1, i, 0.5, wl, g_c, e0, e_kelvin, steady)
-            e_i = _node_density(g_i, d, interior, i, i, 0.0, wl, g_c, e0, e_kelvin, steady)
-        else:
-            e_mid = _energy_density(mid, d, interior, n_in, wl, wsum, dx, g_c, gf, df, e0, e_kelvin, steady)
-            e_i = _energy_density(xi, d, interior, n_in, wl, wsum, dx, g_c, gf, df, e0, e_kelvin, steady)
-        total += (xi - prev) * (e_prev + 4.0 * e_mid + e_i) / 6.0
+        q1 = prev + 0.25 * (xi - prev)
+        q2 = prev + 0.5 * (xi - prev)
+        q3 = prev + 0.75 * (xi - prev)
+        e1 = _energy_density(q1, d, interior, n_in, wl, wb, dx, g_c, gf, df, e0, e_kelvin)
+        e2 = _energy_density(q2, d, interior, n_in, wl, wb, dx, g_c, gf, df, e0, e_kelvin)
+        e3 = _energy_density(q3, d, interior, n_in, wl, wb, dx, g_c, gf, df, e0, e_kelvin)
+        e_i = _energy_density(xi, d, interior, n_in, wl, wb, dx, g_c, gf, df, e0, e_kelvin)
+        total += (xi - prev) * (e_prev + 4.0 * e1 + 2.0 * e2 + 4.0 * e3 + e_i) / 12.0
         prev, e_prev = xi, e_i
         if xi >= x1:
             break
@@ -783,17 +1104,18 @@ def _memory_peak(wsum):
 
 
 @numba.njit(cache=True, nogil=True)
-def _stored_energy(a, d, wl, wsum, dx, g_c, gf, df, e0, e_kelvin, steady):
+def _stored_energy(a, d, wl, wb, dx, g_c, gf, df, e0, e_kelvin):
     """Elastic energy in all springs of both half-rows, J: the integral of
-    `_energy_density` over the contact (interior memory) and over (a, L) (exterior)."""
+    `_energy_density` over the contact (interior memory) and over (a, L) (exterior).
+    A diagnostic (computed on demand): the dissipation is a running sum of its own."""
     n = wl.shape[0]
     n_in = _interior_count(a, dx, n)
     total = 0.0
     if a > 0.0:
-        total += _side_energy(0.0, a, d, True, n_in, wl, wsum, dx, g_c, gf, df, e0, e_kelvin, steady)
+        total += _side_energy(0.0, a, d, True, n_in, wl, wb, dx, g_c, gf, df, e0, e_kelvin)
     length = n * dx
     if wl.shape[1] > 0 and a < length:
-        total += _side_energy(a, length, d, False, n_in, wl, wsum, dx, g_c, gf, df, e0, e_kelvin, steady)
+        total += _side_energy(a, length, d, False, n_in, wl, wb, dx, g_c, gf, df, e0, e_kelvin)
     return total
 
 
@@ -822,11 +1144,13 @@ class Row:
     Keyword arguments (SI): ``dx`` element width, m; ``g_c`` (N,) profile at centres, m;
     ``gf``, ``gint`` (M,) fine profile and its running integral, m and m^2; ``df`` fine
     spacing, m; ``reach`` outermost radius the indenter can touch, m (inf if unbounded);
-    ``wl`` (N, K) Kelvin elongations, m; ``p``, ``p_inv`` (K, K), ``lam`` (K,) 1/s,
-    ``beta`` (K,) the modal chain (see simulator._modal_chain); ``rate`` (K,) free
-    creep-back rates, 1/s; ``e_kelvin`` (K,) Kelvin moduli E_k*, Pa; ``steady`` (K,) steady
-    in-contact fractions ``E_r*/E_k*``; ``e0`` glass modulus E0*, Pa; ``c_crit`` critical
-    glass elongation per sqrt(m), ``dl_c(x) = c_crit sqrt(x)``.
+    ``wl`` (N, K) Kelvin elongations, m; ``wb`` (N, K) their unit-input responses B
+    (dimensionless; None: zeros, a body that never touched); ``p``, ``p_inv`` (K, K),
+    ``lam`` (K,) 1/s, ``beta`` (K,) the modal chain (see simulator._modal_chain); ``rate``
+    (K,) free creep-back rates, 1/s; ``e_kelvin`` (K,) Kelvin moduli E_k*, Pa; ``steady``
+    (K,) steady in-contact fractions ``E_r*/E_k*`` (``kap`` is their sum); ``e0`` glass
+    modulus E0*, Pa; ``c_crit`` critical glass elongation per sqrt(m),
+    ``dl_c(x) = c_crit sqrt(x)``.
     """
 
     def __init__(
@@ -848,6 +1172,7 @@ class Row:
         steady: np.ndarray,
         e0: float,
         c_crit: float,
+        wb: np.ndarray | None = None,
     ) -> None:
         n, k = wl.shape
         m = gf.shape[0]
@@ -858,11 +1183,14 @@ class Row:
             raise ValueError(f"reach must be > 0 (got {reach!r})")
         if e0 <= 0.0 or c_crit < 0.0:
             raise ValueError(f"e0 must be > 0 and c_crit >= 0 (got {e0!r}, {c_crit!r})")
+        if wb is None:
+            wb = np.zeros_like(wl)
         for name, array, shape in (
             ("g_c", g_c, (n,)),
             ("gf", gf, (m,)),
             ("gint", gint, (m,)),
             ("wl", wl, (n, k)),
+            ("wb", wb, (n, k)),
             ("p", p, (k, k)),
             ("p_inv", p_inv, (k, k)),
             ("lam", lam, (k,)),
@@ -876,13 +1204,18 @@ class Row:
         self.e0, self.c_crit = float(e0), float(c_crit)
         self.g_c, self.gf, self.gint = g_c, gf, gint
         self.wl = np.ascontiguousarray(wl)
+        self.wb = np.ascontiguousarray(wb)
         self.wsum = self.wl.sum(axis=1)
+        self.bsum = self.wb.sum(axis=1)
         self.scratch = np.empty_like(self.wl)
+        self.scratch_b = np.empty_like(self.wl)
+        self.diss = np.zeros(n)
         self.p, self.p_inv, self.lam, self.beta, self.rate = p, p_inv, lam, beta, rate
         self.e_kelvin, self.steady = e_kelvin, steady
         self.kap = float(steady.sum())
         # Least profile height per block of TOUCH_BLOCK fine points (`_first_touch`).
         self.gmin = np.minimum.reduceat(gf, np.arange(0, m, TOUCH_BLOCK))
+        self.gmax = np.maximum.reduceat(gf, np.arange(0, m, TOUCH_BLOCK))
         self.out = np.zeros(OUT_SIZE)
 
     @property
@@ -892,12 +1225,17 @@ class Row:
         return (
             self.wl,
             self.wsum,
+            self.wb,
+            self.bsum,
             self.scratch,
+            self.scratch_b,
+            self.diss,
             self.dx,
             self.g_c,
             self.gf,
             self.gint,
             self.gmin,
+            self.gmax,
             self.df,
             self.e0,
             self.c_crit,
@@ -909,7 +1247,6 @@ class Row:
             self.rate,
             self.kap,
             self.e_kelvin,
-            self.steady,
             self.out,
         )
 
@@ -922,23 +1259,39 @@ class Row:
         """Domain length L, m."""
         return self.dx * self.elements
 
-    def with_memory(self, wl: np.ndarray) -> Row:
+    def memory(self) -> tuple[np.ndarray, np.ndarray]:
+        """Copies of the Kelvin state: elongations ``wl`` and unit responses ``wb``, (N, K)."""
+        return self.wl.copy(), self.wb.copy()
+
+    def with_memory(self, wl: np.ndarray, wb: np.ndarray | None = None) -> Row:
         """A new row with the same geometry and chain (shared, never written) and its own
-        copy of the Kelvin state `wl` (N, K)."""
+        copy of the Kelvin state `wl`, `wb` (N, K; wb None: zeros)."""
         clone = object.__new__(Row)
         clone.__dict__.update(self.__dict__)
         clone.wl = np.empty_like(self.wl)
+        clone.wb = np.empty_like(self.wb)
         clone.wsum = np.empty_like(self.wsum)
+        clone.bsum = np.empty_like(self.bsum)
         clone.scratch = np.empty_like(self.scratch)
+        clone.scratch_b = np.empty_like(self.scratch_b)
+        clone.diss = np.zeros_like(self.diss)
         clone.out = np.zeros(OUT_SIZE)
-        clone.set_memory(wl)
+        clone.set_memory(wl, wb)
         return clone
 
-    def set_memory(self, wl: np.ndarray) -> None:
-        """Replace the Kelvin state (N, K) after validation."""
+    def set_memory(self, wl: np.ndarray, wb: np.ndarray | None = None) -> None:
+        """Replace the Kelvin state (N, K each; wb None: zeros) after validation."""
         _check("wl", wl, self.wl.shape)
+        if wb is not None:
+            _check("wb", wb, self.wb.shape)
         self.wl[...] = wl
         self.wsum[...] = wl.sum(axis=1)
+        if wb is None:
+            self.wb[...] = 0.0
+            self.bsum[...] = 0.0
+        else:
+            self.wb[...] = wb
+            self.bsum[...] = wb.sum(axis=1)
 
 
 def advance(
@@ -949,7 +1302,7 @@ def advance(
 
     Returns ``(status, out)``; ``out[OUT_RADIUS]`` is the new contact radius (m),
     ``out[OUT_FORCE]`` the force (N), ``out[OUT_WORK]`` the work input (J),
-    ``out[OUT_STORED]`` the stored energy at the end (J, `stored_energy`). On STATUS_GROW
+    ``out[OUT_DISSIPATED]`` the energy dissipated over the step (J, >= 0). On STATUS_GROW
     the row is partly advanced and must be restored by the caller.
     """
     _check_scalars(radius=radius, d0=d0, d1=d1, dt=dt, max_edge_move=max_edge_move)
@@ -972,7 +1325,17 @@ def force(row: Row, radius: float, depth: float) -> float:
     _check_scalars(radius=radius, depth=depth)
     return float(
         _force(
-            float(radius), float(depth), row.wsum, row.dx, row.g_c, row.gf, row.gint, row.df, row.e0, row.kap
+            float(radius),
+            float(depth),
+            row.wsum,
+            row.bsum,
+            row.dx,
+            row.g_c,
+            row.gf,
+            row.gint,
+            row.df,
+            row.e0,
+            row.kap,
         )
     )
 
@@ -985,14 +1348,15 @@ def locate_edge(row: Row, radius: float, depth: float) -> tuple[float, int, bool
         float(radius),
         float(depth),
         row.wsum,
+        row.bsum,
         row.dx,
         row.g_c,
         row.gf,
         row.gmin,
+        row.gmax,
         row.df,
         row.c_crit,
         row.reach,
-        row.kap,
     )
     return float(new_radius), int(motion), bool(grow)
 
@@ -1002,17 +1366,7 @@ def stored_energy(row: Row, radius: float, depth: float) -> float:
     _check_scalars(radius=radius, depth=depth)
     return float(
         _stored_energy(
-            float(radius),
-            float(depth),
-            row.wl,
-            row.wsum,
-            row.dx,
-            row.g_c,
-            row.gf,
-            row.df,
-            row.e0,
-            row.e_kelvin,
-            row.steady,
+            float(radius), float(depth), row.wl, row.wb, row.dx, row.g_c, row.gf, row.df, row.e0, row.e_kelvin
         )
     )
 
@@ -1024,24 +1378,22 @@ def criterion_gap(row: Row, x: float, depth: float, radius: float, *, interior: 
     n_in = int(_interior_count(float(radius), row.dx, n))
     lo, hi = (0, n_in - 1) if interior else (n_in, n - 1)
     return float(
-        _h(
-            float(x),
-            float(depth),
-            row.wsum,
-            lo,
-            hi,
-            row.dx,
-            row.g_c,
-            row.gf,
-            row.df,
-            row.c_crit,
-            row.kap if interior else 0.0,
-        )
+        _h(float(x), float(depth), row.wsum, row.bsum, lo, hi, row.dx, row.g_c, row.gf, row.df, row.c_crit)
     )
 
 
-def kelvin_update(row: Row, n_in: int, d0: float, d1: float, dt: float) -> None:
-    """Exact Kelvin-chain update of `row` in place (see `_kelvin_update`)."""
+def memory_at(row: Row, x: float, radius: float, *, interior: bool) -> float:
+    """Memory w(x), m, as the criterion and force see it on one side of `radius`."""
+    _check_scalars(x=x, radius=radius)
+    n = row.elements
+    n_in = int(_interior_count(float(radius), row.dx, n))
+    lo, hi = (0, n_in - 1) if interior else (n_in, n - 1)
+    return float(_w_side(float(x), row.wsum, row.bsum, lo, hi, row.dx, row.g_c, row.gf, row.df))
+
+
+def kelvin_update(row: Row, n_in: int, d0: float, d1: float, dt: float) -> float:
+    """Exact Kelvin-chain update of `row` in place (see `_kelvin_update`); returns the
+    energy its dampers dissipated, J."""
     _check_scalars(d0=d0, d1=d1, dt=dt)
     if not 0 <= n_in <= row.elements:
         raise ValueError(f"n_in must be in [0, {row.elements}] (got {n_in})")
@@ -1050,6 +1402,9 @@ def kelvin_update(row: Row, n_in: int, d0: float, d1: float, dt: float) -> None:
     _kelvin_update(
         row.wl,
         row.wsum,
+        row.wb,
+        row.bsum,
+        row.diss,
         int(n_in),
         float(d0),
         float(d1),
@@ -1060,29 +1415,28 @@ def kelvin_update(row: Row, n_in: int, d0: float, d1: float, dt: float) -> None:
         row.lam,
         row.beta,
         row.rate,
+        row.e_kelvin,
+        row.dx,
     )
+    return float(row.diss.sum()) if row.wl.shape[1] else 0.0
 
 
-def remap_memory(row: Row, radius: float, depth: float, elements: int, length: float) -> np.ndarray:
-    """The Kelvin state of `row` (contact radius m, depth m) on a new grid of `elements`
-    over (0, length], shape (elements, K); see `_remap`."""
-    _check_scalars(radius=radius, depth=depth, length=length)
+def remap_memory(
+    row: Row, radius: float, elements: int, length: float, centre_profile: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """The Kelvin state (wl, wb) of `row` (contact radius m) on a new grid of `elements`
+    over (0, length] whose profile at the centres is `centre_profile` (m), each (elements,
+    K); see `_remap`."""
+    _check_scalars(radius=radius, length=length)
     if elements < 1 or not length > 0.0:
         raise ValueError(f"need elements >= 1 and length > 0 (got {elements}, {length!r})")
+    _check("centre_profile", centre_profile, (int(elements),))
     out = np.empty((int(elements), row.wl.shape[1]))
+    out_b = np.empty_like(out)
     _remap(
-        row.wl,
-        float(radius),
-        float(depth),
-        row.dx,
-        row.g_c,
-        row.gf,
-        row.df,
-        row.steady,
-        float(length) / elements,
-        out,
+        row.wl, row.wb, float(radius), row.dx, row.g_c, float(length) / elements, centre_profile, out, out_b
     )
-    return out
+    return out, out_b
 
 
 def warm_up() -> None:
@@ -1111,15 +1465,18 @@ def warm_up() -> None:
         c_crit=0.1,
     )
     advance(row, 0.0, 0.0, 0.1, 0.01, max_substep=0.0, max_edge_move=0.25)
+    advance(row, 0.3, 0.1, 0.2, 0.0, max_substep=0.0, max_edge_move=0.25)
     force(row, 0.3, 0.1)
     stored_energy(row, 0.3, 0.1)
     criterion_gap(row, 0.3, 0.1, 0.3, interior=True)
+    memory_at(row, 0.3, 0.3, interior=True)
     kelvin_update(row, 2, 0.0, 0.1, 0.01)
-    remap_memory(row, 0.3, 0.1, 3, 2.0)
+    remap_memory(row, 0.3, 3, 2.0, ((np.arange(3) + 0.5) * 2.0 / 3.0) ** 2)
     times = np.array([0.0, 0.1, 0.2])
     depths = np.array([0.0, 0.3, 0.1])
     _advance_rows(
         *row.kernel_args,
+        np.empty_like(row.wl),
         np.empty_like(row.wl),
         0.0,
         0.0,
