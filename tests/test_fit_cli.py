@@ -82,10 +82,16 @@ def test_segment_and_time_range_choose_the_fitted_samples(bag: Path) -> None:
 def test_bad_segment_or_time_range_is_one_error_line(bag: Path, tmp_path: Path, capsys) -> None:
     start = write_scene(tmp_path / "start.yaml", START)
     out = tmp_path / "fitted.yaml"
-    for extra in (["--time-range", "0.2", "0.1"], ["--time-range", "5", "6"]):
+    for extra, message in (
+        (["--time-range", "0.2", "0.1"], "T0 < T1"),
+        (["--time-range", "5", "6"], "force samples"),
+        # The pull-off (t = 0.17 s) outside what is fitted: w (free by default) cannot be fixed.
+        (["--time-range", "0", "0.1"], "work_of_adhesion cannot be identified"),
+        (["--segment", "approach"], "work_of_adhesion cannot be identified"),
+    ):
         assert main(_fit_args(bag, start, out, *extra)) == 2
         err = capsys.readouterr().err.strip().splitlines()
-        assert len(err) == 1 and err[0].startswith("viscoadh fit: error: "), err
+        assert len(err) == 1 and err[0].startswith("viscoadh fit: error: ") and message in err[0], err
         assert not out.exists()
 
 

@@ -19,12 +19,11 @@ other side: the RMS of the standardised errors ``log(value/truth)/sigma`` must l
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
-
 from fit_records import DEPTH_TOPIC, TRUE, scene, standard_history, true_force, write_record
+
 from viscoadh_ros.experiment import load_experiment
 from viscoadh_ros.fitting import fit
 from viscoadh_ros.io.bag import Bag

@@ -16,8 +16,8 @@ How it finds the optimum from a poor start (issue 12):
    own values (the simulator's default) moved the grid with every trial and made the cost a
    sawtooth along w at the scale of a finite-difference step: the optimiser stopped where it
    started.
-2. **The pull-off jump is masked**: a measured change between two samples that stands out
-   of its neighbours' changes and of the noise (:func:`smooth_samples`) is left out with
+2. **The pull-off jump is masked**: a measured change between two samples beyond the noise
+   and against the depth's change (:func:`smooth_samples`) is left out with
    :data:`JUMP_MARGIN` samples either side.
 3. **A global stage**: the cost at :data:`GLOBAL_POINTS` scrambled-Sobol points of the box
    (seeded: same record and options, same numbers), then a local descent (``least_squares``,
@@ -104,13 +104,14 @@ POLISH_SIGMAS = 0.2
 POLISH_TRUST = 3.0
 #: Two-sided 95 % normal quantile.
 Z95 = 1.959963984540054
-#: A change of the measured force between consecutive samples is a jump when it exceeds this
-#: many noise deviations of a change AND three times the median of its four neighbours'
-#: changes (a fast ramp or a reversal is not a jump); JUMP_MARGIN samples either side go too.
+#: A change of the measured force between consecutive samples beyond this many noise
+#: deviations of a change, against the depth's change, is a jump (`smooth_samples`).
 JUMP_NOISE = 10.0
 JUMP_MARGIN = 2
-#: A pull-off needs a tensile force beyond this many noise deviations, released within them.
+#: A pull-off needs a tensile force beyond this many noise deviations, then that many samples
+#: in a row at zero within them.
 PULL_OFF_NOISE_BAND = 5.0
+PULL_OFF_FREE_SAMPLES = 5
 #: The fit's grid: this margin over the largest reachable contact radius, and at most this
 #: many times the preset's elements to keep the start's contact as finely resolved.
 GRID_MARGIN = 1.2
@@ -258,6 +259,7 @@ class FitResult:
     #: Largest Gauss-Newton step the secant model still proposes at the result, in standard
     #: deviations of the parameter (the stationarity test's number).
     stationarity: float = 0.0
+    model_time: float = 0.0  # s of wall_time spent running the model
 
     def row(self) -> dict[str, Any]:
         """One flat summary row (the batch runner's table): every value, its interval and
@@ -296,25 +298,46 @@ def _noise_floor(force: NDArray[np.float64]) -> float:
 
 def has_pull_off(force: NDArray[np.float64]) -> bool:
     """True if ``force`` (N, > 0 compressive) becomes tensile beyond its noise and later
-    returns to zero within it: the contact was pulled off."""
+    stays at zero within it for PULL_OFF_FREE_SAMPLES samples in a row: the contact was
+    pulled off (a reload that only crosses zero is not)."""
     if force.size < 4:
         return False
     band = PULL_OFF_NOISE_BAND * _noise_floor(force)
     lowest = int(np.argmin(force))
-    return bool(force[lowest] < -band and np.any(np.abs(force[lowest + 1 :]) <= band))
+    if not force[lowest] < -band:
+        return False
+    free = np.abs(force[lowest + 1 :]) <= band
+    run = np.convolve(free.astype(np.int64), np.ones(PULL_OFF_FREE_SAMPLES, dtype=np.int64), "valid")
+    return bool(run.size and np.max(run) >= PULL_OFF_FREE_SAMPLES)
 
 
-def smooth_samples(force: NDArray[np.float64], noise: float | None = None) -> NDArray[np.bool_]:
-    """Mask of the samples of a measured force away from its jumps (see the module docstring)."""
+def smooth_samples(
+    force: NDArray[np.float64], noise: float | None = None, depth: NDArray[np.float64] | None = None
+) -> NDArray[np.bool_]:
+    """Mask of the samples of a measured force away from its jumps (snap-in, pull-off).
+
+    With ``depth`` (m, at the force samples): a jump is a change beyond JUMP_NOISE noise
+    deviations of a change against the depth's own change (the force rises while the depth
+    falls, or falls while it rises: an unstable branch), or a release from tension to zero
+    at a held depth. A steep ramp, a reversal or a fast relaxation is never one, however
+    coarsely sampled. Without ``depth``: a change beyond JUMP_NOISE deviations and three
+    times the median of its four neighbours' changes. JUMP_MARGIN samples either side go too.
+    """
     keep = np.ones(force.size, dtype=bool)
     if force.size < 5:
         return keep
     sigma = _noise_floor(force) if noise is None else noise
-    change = np.abs(np.diff(force))
-    padded = np.pad(change, 2, mode="edge")
-    neighbours = np.stack([padded[:-4], padded[1:-3], padded[3:-1], padded[4:]])
-    typical = np.median(neighbours, axis=0)
-    jumps = (change > JUMP_NOISE * math.sqrt(2.0) * sigma) & (change > 3.0 * typical)
+    change = np.diff(force)
+    large = np.abs(change) > JUMP_NOISE * math.sqrt(2.0) * sigma
+    if depth is not None:
+        moved = np.diff(depth)
+        band = PULL_OFF_NOISE_BAND * sigma
+        released = (moved == 0.0) & (force[:-1] < -band) & (np.abs(force[1:]) <= band)
+        jumps = large & ((change * moved < 0.0) | released)
+    else:
+        padded = np.pad(np.abs(change), 2, mode="edge")
+        neighbours = np.stack([padded[:-4], padded[1:-3], padded[3:-1], padded[4:]])
+        jumps = large & (np.abs(change) > 3.0 * np.median(neighbours, axis=0))
     for jump in np.flatnonzero(jumps):
         keep[max(jump - JUMP_MARGIN, 0) : jump + 1 + JUMP_MARGIN + 1] = False
     return keep
@@ -405,6 +428,7 @@ class _Problem:
         self.start, self.used, self.noise = start, used, noise
         self.measured = experiment.measured_force[used]
         self.runs = runs
+        self.model_time = 0.0  # s spent in run_model
 
     def values(self, u: NDArray[np.float64]) -> dict[str, float]:
         trial = dict(self.start)
@@ -415,11 +439,14 @@ class _Problem:
         """Model force (N) at the used samples for log-ratios ``u``."""
         self.runs += 1
         base = self.contact if contact is None else contact
+        started = wallclock.perf_counter()
         try:
             run = run_model(with_parameters(base, self.values(u), self.kelvin), self.experiment)
         except ValueError:
             # Outside what the model accepts: a large residual steers the optimiser back.
             return self.measured + 1e3 * self.noise * math.sqrt(self.measured.size)
+        finally:
+            self.model_time += wallclock.perf_counter() - started
         return run.model_force[self.used]
 
     def residual(self, u: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -433,7 +460,9 @@ class _Problem:
         return np.column_stack(columns)
 
 
-def _identify_checks(experiment: Experiment, free: Sequence[str], used: NDArray[np.bool_]) -> None:
+def _identify_checks(
+    experiment: Experiment, free: Sequence[str], used: NDArray[np.bool_], selected: NDArray[np.bool_]
+) -> None:
     if np.any(experiment.input_mode != DEPTH):
         raise FitError("fit needs depth-controlled inputs; the record holds FORCE-mode commands")
     if int(np.count_nonzero(used)) < len(free) + 2:
@@ -441,10 +470,10 @@ def _identify_checks(experiment: Experiment, free: Sequence[str], used: NDArray[
             f"{int(np.count_nonzero(used))} force samples (after the segment, time range and jump "
             f"masks) cannot fit {len(free)} parameters"
         )
-    if "work_of_adhesion" in free and not has_pull_off(experiment.measured_force):
+    if "work_of_adhesion" in free and not has_pull_off(experiment.measured_force[selected]):
         raise FitError(
-            "work_of_adhesion cannot be identified: the record holds no pull-off (a tensile force "
-            "released back to zero); hold it (leave it out of --free) or record a retraction"
+            "work_of_adhesion cannot be identified: the fitted samples hold no pull-off (a tensile "
+            "force released back to zero); hold it (leave it out of --free) or record a retraction"
         )
 
 
@@ -580,8 +609,12 @@ def fit(
         if not start[name] > 0.0 or not math.isfinite(start[name]):
             raise InputError(f"start value of {name} must be finite and > 0 (got {start[name]})")
     noise = _noise_floor(experiment.measured_force)
-    used = smooth_samples(experiment.measured_force, noise) & segment_samples(experiment, options)
-    _identify_checks(experiment, free, used)
+    depth = np.interp(
+        experiment.time(experiment.measured_ns), experiment.time(experiment.input_ns), experiment.input_value
+    )
+    selected = segment_samples(experiment, options)
+    used = smooth_samples(experiment.measured_force, noise, depth) & selected
+    _identify_checks(experiment, free, used, selected)
 
     half = math.log(options.bounds_factor)
     bounds = {n: (start[n] / options.bounds_factor, start[n] * options.bounds_factor) for n in free}
@@ -624,6 +657,7 @@ def fit(
     # Polish on the secant model, then again on grids refined by 2 until the optimum stops
     # moving: the last shift is the discretisation's model-error term.
     smallest = max(step / 3.0, MIN_SECANT)
+    model_time = 0.0
     polished = _polish(problem, u, lower, upper, smallest)
     if float(np.max(polished.sigmas)) > STATIONARY_SIGMAS:
         # The polish stopped on a rough patch: descend once more from where it got to.
@@ -632,6 +666,7 @@ def fit(
     for _ in range(MAX_REFINEMENTS):
         elements *= 2
         finer = dataclasses.replace(grid_contact, numerics=dataclasses.replace(numerics, elements=elements))
+        model_time += problem.model_time
         problem = _Problem(finer, experiment, free, kelvin, start, used, noise, runs=problem.runs)
         refined = _polish(problem, polished.u, lower, upper, smallest, polished.steps)
         shift, polished = refined.u - polished.u, refined
@@ -689,6 +724,7 @@ def fit(
         wall_time=wallclock.perf_counter() - started,
         bounds=bounds,
         stationarity=float(sigmas[worst]),
+        model_time=model_time + problem.model_time,
     )
 
 

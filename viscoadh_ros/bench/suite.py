@@ -9,7 +9,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-SECTIONS = ("kernel", "accuracy", "node", "replay")
+SECTIONS = ("kernel", "accuracy", "node", "replay", "fit")
 #: The results keys each section writes (the soak is asked for by --soak, not --sections); a
 #: merge replaces exactly these.
 SECTION_KEYS = {
@@ -17,6 +17,7 @@ SECTION_KEYS = {
     "accuracy": ("accuracy", "presets"),
     "node": ("node", "startup_s"),
     "replay": ("replay",),
+    "fit": ("fit",),
     "soak": ("soak",),
 }
 #: Top-level keys that describe the run the report header names.
@@ -41,6 +42,9 @@ class Plan:
     node_duration_s: float
     replay_seconds: float
     replay_repeats: int
+    fit_samples: int = 5000
+    fit_starts: int = 8
+    fit_kelvin_starts: int = 3
 
 
 FULL = Plan(
@@ -74,6 +78,9 @@ QUICK = Plan(
     node_duration_s=5.0,
     replay_seconds=10.0,
     replay_repeats=1,
+    fit_samples=1000,
+    fit_starts=2,
+    fit_kelvin_starts=1,
 )
 
 
@@ -149,6 +156,13 @@ def run(
 
         progress(f"replay: {plan.replay_seconds:g} s of 1 kHz commands")
         results["replay"] = replay_benchmark(seconds=plan.replay_seconds, repeats=plan.replay_repeats)
+    if "fit" in sections:
+        from viscoadh_ros.bench.fit_speed import fit_benchmark
+
+        progress(f"fit: {plan.fit_starts} + {plan.fit_kelvin_starts} fits, {plan.fit_samples} samples each")
+        results["fit"] = fit_benchmark(
+            samples=plan.fit_samples, starts=plan.fit_starts, kelvin_starts=plan.fit_kelvin_starts
+        )
     if soak_minutes is not None:
         from viscoadh_ros.bench.soak import soak
 
