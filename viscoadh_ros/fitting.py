@@ -77,8 +77,9 @@ SECANT_STEP = 0.02
 #: whose force flips by ~1 noise deviation as an element event crosses a stamp), narrow
 #: against its curvature.
 SECANT_SIGMAS = 3.0
-#: Narrowest secant, in u.
-MIN_SECANT = 1e-3
+#: Narrowest secant, in u: wide against the roughness of long records (whose standard
+#: deviations are small), narrow against the curvature (its bias ~ width^2 is ~1e-5 here).
+MIN_SECANT = 5e-3
 #: Grid refinements (elements x2 each) of the polish at most, and the shift of the optimum
 #: (in standard deviations) below which a refinement is the last.
 MAX_REFINEMENTS = 2
@@ -568,9 +569,10 @@ def _polish(
             sigmas = np.where(np.isfinite(sigma_u), np.abs(gn) / sigma_u, 0.0)
         if float(np.max(sigmas)) <= POLISH_SIGMAS:
             break
-        if float(np.max(sigmas)) <= POLISH_TRUST:
-            # Within a few standard deviations the secant model is the judge: what roughness
-            # remains moves the cost at a single trial point by about one unit.
+        if np.all((np.abs(gn) <= POLISH_TRUST * sigma_u) | (np.abs(gn) <= steps)):
+            # Within a few standard deviations, or within the secant's own span, the secant
+            # model is the judge: what roughness remains moves the cost at a single trial
+            # point by about one unit.
             u = np.clip(u + gn, lower, upper)
             r = problem.residual(u)
             continue
