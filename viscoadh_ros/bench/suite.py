@@ -43,8 +43,8 @@ class Plan:
     replay_seconds: float
     replay_repeats: int
     fit_samples: int = 5000
-    fit_starts: int = 8
-    fit_kelvin_starts: int = 3
+    fit_starts: int = 4
+    fit_kelvin_starts: int = 1
 
 
 FULL = Plan(
