@@ -94,6 +94,12 @@ def fit_section(fit: dict[str, Any]) -> list[str]:
     lines += _table(
         ["case", "samples", "recovered", "covered", "model runs", "wall s", "CPU s", "target (CPU)"], rows
     )
+    failed = [
+        (name, f) for name, case in fit["cases"].items() for f in case["fits"] if f["status"] == "failed"
+    ]
+    if failed:
+        lines += ["", "Fits that refused to report (not converged, never a false success):", ""]
+        lines += [f"- {name}, CPU {_g(f['cpu_s'])} s: {f['reason']}" for name, f in failed]
     return lines + [""]
 
 
