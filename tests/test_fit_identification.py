@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 import pytest
 from fit_records import DEPTH_TOPIC, TRUE, scene, standard_history, true_force, write_record
 
@@ -52,3 +53,28 @@ def test_fit_from_a_poor_start_finds_the_truth_within_its_stated_interval(record
         # tested over many records in test_fit_coverage.py.
         off = abs(math.log(value / truth))
         assert off <= 3.0 * sigma, f"{name}: {value:g} +- {sigma:.2%}, truth {truth:g}"
+
+
+def test_the_fits_grid_makes_the_cost_smooth_along_w(record) -> None:
+    """The cause of the stuck w: on the fit's one grid (`fit_grid`, sized from the deepest
+    point and the box) the cost along a fine scan of w (steps of 1e-4 in log w, the old
+    finite-difference step) has one minimum; the simulator's own domain, sized from each
+    trial's w, changed sign 5 times over this scan in 0.1.0."""
+    import dataclasses
+
+    from viscoadh_ros.experiment import run_model
+    from viscoadh_ros.fitting import fit_grid, smooth_samples, with_parameters
+
+    contact = scene(TRUE).contacts[0]
+    bounds = {n: (v / 10.0, v * 10.0) for n, v in TRUE.items()}
+    domain, elements = fit_grid(contact, record, bounds)
+    grid = dataclasses.replace(
+        contact, numerics=dataclasses.replace(contact.numerics, domain_radius=domain, elements=elements)
+    )
+    keep = smooth_samples(record.measured_force)
+    costs = []
+    for w in TRUE["work_of_adhesion"] * np.exp(np.linspace(-0.003, 0.003, 61)):
+        run = run_model(with_parameters(grid, {**TRUE, "work_of_adhesion": float(w)}, 1), record)
+        costs.append(float(np.sum((run.model_force - record.measured_force)[keep] ** 2)))
+    turns = int(np.count_nonzero(np.diff(np.sign(np.diff(costs)))))
+    assert turns <= 2, f"the cost along w turns {turns} times: {np.round(np.array(costs) / min(costs), 5)}"
