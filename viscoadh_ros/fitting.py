@@ -2,23 +2,43 @@
 
 Parameters are named as in physics.md: ``G0`` (glass shear modulus, Pa), ``G1..GK`` (Kelvin
 shear moduli, Pa), ``eta1..etaK`` (Kelvin viscosities, Pa s) and ``work_of_adhesion`` (J/m^2).
-The fit works on their logarithms (all are positive and span decades) with residuals
-``(model - measured) / max|measured|`` at the measured-force stamps, in two stages
-(physics.md section 7): the compressive samples first with the work of adhesion held, then
-every sample with every free parameter. Uncertainties (one standard deviation) come from the
-Jacobian at the optimum: ``cov = s^2 (J^T J)^-1`` with the residual variance ``s^2``.
+The fit works in ``u = log(p / p_start)`` (all are positive and span decades) inside a box of
+``p_start / bounds_factor .. p_start * bounds_factor``, on residuals in units of the record's
+noise level ``(model - measured) / sigma`` at the measured-force stamps.
 
-The model force is not a smooth function of the parameters everywhere: an unstable jump
-(snap-in, pull-off under displacement control) moves from one sample to the next as the
-parameters change, and the MDR row's finite elements make the force step slightly as the
-contact edge crosses them. So (1) the measured samples next to a jump of the measured force
-are left out of the residuals, and (2) the Jacobian of the uncertainty is a central secant over
-:data:`SECANT_STEP` of each log-parameter, wide against the element steps, rather than the
-optimiser's local difference quotient, which a step can blow up (and the error bar shrink).
+How it finds the optimum from a poor start (issue 12):
 
-A parameter the data cannot fix (no pull-off for the work of adhesion, no rate or hold
-variation for a viscosity, two parameters that only act together) makes the fit fail with a
-:class:`FitError` naming it, never a value with a meaningless error bar.
+1. **One grid for the whole fit.** The model's element row is sized once, from the record's
+   deepest point and the box (:func:`fit_grid`: the largest contact radius any trial can reach
+   is the glass-modulus JKR radius at the deepest depth with the largest work of adhesion and
+   the smallest G0 of the box: elements beyond the largest radius ever in contact are fresh,
+   and a fresh element attaches on the glass criterion alone). Sizing it from each trial's
+   own values (the simulator's default) moved the grid with every trial and made the cost a
+   sawtooth along w at the scale of a finite-difference step: the optimiser stopped where it
+   started.
+2. **The pull-off jump is masked**: a measured change between two samples beyond the noise
+   and against the depth's change (:func:`smooth_samples`) is left out with
+   :data:`JUMP_MARGIN` samples either side.
+3. **A global stage**: the cost at :data:`GLOBAL_POINTS` scrambled-Sobol points of the box
+   (seeded: same record and options, same numbers), then a local descent (``least_squares``,
+   trust region in the box) from the start and from the best global points, keeping the
+   lowest cost. The descent's difference step is matched to what roughness remains
+   (:func:`_difference_step`).
+4. **A stationarity test**: at the optimum a central secant Jacobian gives the Gauss-Newton
+   step; if it still proposes more than one standard deviation in any parameter the fit takes
+   it and descends again, and a fit whose step stays above :data:`STATIONARY_SIGMAS` is
+   reported as not converged, never as a success.
+5. **Intervals**: linearised from the secant Jacobian, ``cov = s^2 (J^T J)^-1`` with the
+   residual variance ``s^2``, plus a model-error term for the discretisation: the shift of
+   the optimum that refining the grid (twice the elements) would cause, added in quadrature.
+   The 95 % interval is ``u +- 1.96 sigma_u`` (asymmetric in the parameter). Their coverage is
+   tested on seeded synthetic records (tests/test_fit_coverage.py).
+
+A parameter the record cannot identify (no dependence, a flat valley with another one, or a
+relative standard deviation above :data:`MAX_RELATIVE_UNCERTAINTY`) is reported as not
+identified with its interval (clipped to the box), not as a point with a meaningless error
+bar. A record that cannot say anything about a parameter at all (a work of adhesion without a
+pull-off) is refused before fitting with a :class:`FitError` naming it.
 """
 
 from __future__ import annotations
@@ -26,38 +46,77 @@ from __future__ import annotations
 import dataclasses
 import math
 import re
+import time as wallclock
 from collections.abc import Sequence
-from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.optimize import OptimizeResult, least_squares
+from scipy.optimize import least_squares
+from scipy.stats import qmc
 
 from viscoadh_ros.core.errors import InputError
-from viscoadh_ros.experiment import Experiment, run_model
+from viscoadh_ros.experiment import DEPTH, Experiment, run_model
 
 if TYPE_CHECKING:
     from viscoadh_ros.core.config import ContactConfig
 
 _NAME = re.compile(r"^(G0|G[1-9]\d*|eta[1-9]\d*|work_of_adhesion)$")
 UNITS = {"G": "Pa", "eta": "Pa s", "work_of_adhesion": "J/m^2"}
-#: Largest relative standard deviation accepted as "identified".
+SEGMENTS = ("both", "approach", "retract")
+#: Largest standard deviation of a log-parameter (about +-50 %) accepted as "identified".
 MAX_RELATIVE_UNCERTAINTY = 0.5
-#: Condition number of the column-scaled Jacobian beyond which parameters only act together.
+#: Singular-value ratio of the column-scaled Jacobian beyond which parameters only act together.
 MAX_CONDITION = 1e6
-#: Half-width of the central secant of the uncertainty Jacobian, in log-parameter (10 %).
-#: At 2 % the element steps' roughness passed for curvature: on tutorial 2's record a
-#: four-parameter fit stated G0 +-4.7 % while its cost was flat from 1.2e6 to 2.1e6 Pa.
-SECANT_STEP = 0.1
-#: Multiples of the start G0 that a fit of G0 with other parameters descends from (best kept).
-G0_START_FACTORS = (1.0, 0.5, 2.0)
-#: A change of the measured force between consecutive samples larger than this fraction of
-#: max|F| (and than 10 median changes) is a jump; JUMP_MARGIN samples either side are left out.
-JUMP_FRACTION = 0.1
+#: Half-width of the central secant of the stationarity test and the intervals, in u. With one
+#: grid for the fit the cost is smooth at this scale (0.1.0 needed 10 % against the moving grid).
+SECANT_STEP = 0.02
+#: The secant of the polish and the intervals spans this many standard deviations of each
+#: parameter (at least 3 difference steps): wide against the model's roughness (single samples
+#: whose force flips by ~1 noise deviation as an element event crosses a stamp), narrow
+#: against its curvature.
+SECANT_SIGMAS = 3.0
+#: Narrowest secant, in u: wide against the roughness of long records (whose standard
+#: deviations are small), narrow against the curvature (its bias ~ width^2 is ~1e-5 here).
+MIN_SECANT = 5e-3
+#: Grid refinements (elements x2 each) of the polish at most, and the shift of the optimum
+#: (in standard deviations) below which a refinement is the last.
+MAX_REFINEMENTS = 2
+REFINED_SIGMAS = 1.0
+#: Default half-width of the search box: each free parameter within start/10 .. start*10.
+BOUNDS_FACTOR = 10.0
+#: Scrambled-Sobol points of the global stage, and how many of the best start local descents.
+GLOBAL_POINTS = 16
+GLOBAL_DESCENTS = 2
+#: A descent whose reduced chi-square is within this many of its standard deviations
+#: (sqrt(2/dof)) of 1 fits to the noise: no other point of the box can do significantly better.
+NOISE_CONSISTENT = 3.0
+#: Cost evaluations per local descent at most (each iteration also runs the model once per
+#: free parameter for its Jacobian).
+DESCENT_EVALUATIONS = 25
+#: A fit whose Gauss-Newton step at the optimum exceeds this many standard deviations of a
+#: parameter is not converged.
+STATIONARY_SIGMAS = 2.0
+#: Gauss-Newton steps of the polish at most, and the step (in standard deviations) it stops at.
+POLISH_STEPS = 6
+POLISH_SIGMAS = 0.2
+#: Polish steps up to this many standard deviations are taken on the secant model's word.
+POLISH_TRUST = 3.0
+#: Two-sided 95 % normal quantile.
+Z95 = 1.959963984540054
+#: A change of the measured force between consecutive samples beyond this many noise
+#: deviations of a change, against the depth's change, is a jump (`smooth_samples`).
+JUMP_NOISE = 10.0
 JUMP_MARGIN = 2
-#: A pull-off needs a tensile force beyond this many noise deviations, released within them.
+#: A pull-off needs a tensile force beyond this many noise deviations, then that many samples
+#: in a row at zero within them.
 PULL_OFF_NOISE_BAND = 5.0
+PULL_OFF_FREE_SAMPLES = 5
+#: The fit's grid: this margin over the largest reachable contact radius, and at most this
+#: many times the preset's elements to keep the start's contact as finely resolved.
+GRID_MARGIN = 1.2
+MAX_ELEMENT_FACTOR = 4
 
 
 class FitError(InputError):
@@ -144,28 +203,388 @@ def initial_values(contact: ContactConfig, kelvin: int) -> dict[str, float]:
 
 
 @dataclass(frozen=True)
+class FitOptions:
+    """How to fit (everything but the record and the start scene).
+
+    segment: which measured samples count: ``both``, ``approach`` (the depth last moved
+    down into the body) or ``retract`` (it last moved out). time_range: ``(t0, t1)`` s since
+    the first input, or None for all. bounds_factor: the box, start/f .. start*f (> 1).
+    seed: of the global stage's Sobol points.
+    """
+
+    segment: str = "both"
+    time_range: tuple[float, float] | None = None
+    bounds_factor: float = BOUNDS_FACTOR
+    seed: int = 0
+
+    def __post_init__(self) -> None:
+        if self.segment not in SEGMENTS:
+            raise InputError(f"segment must be one of {', '.join(SEGMENTS)} (got {self.segment!r})")
+        if self.time_range is not None:
+            t0, t1 = (float(v) for v in self.time_range)
+            if not (math.isfinite(t0) and math.isfinite(t1) and t0 < t1):
+                raise InputError(f"time range must be two finite times T0 < T1, s (got {self.time_range!r})")
+        if not (math.isfinite(self.bounds_factor) and self.bounds_factor > 1.0):
+            raise InputError(f"bounds factor must be a finite number > 1 (got {self.bounds_factor!r})")
+
+
+@dataclass(frozen=True)
 class FitResult:
-    """Fitted values (SI) with one-sigma uncertainties, and the fit error."""
+    """Fitted values (SI), their 95 % intervals and standard deviations, and the fit error.
+
+    ``uncertainty`` is one standard deviation of each free parameter (``value * sigma_u`` of
+    its log); ``interval`` the 95 % interval ``(lo, hi)``; ``identified`` False for a
+    parameter the record cannot fix (its interval then says what it can: the box when
+    nothing). ``noise`` is the record's own noise level (N, from its second differences),
+    ``rmse``/``r2`` are over the fitted samples (``used``, a mask over the measured ones).
+    """
 
     values: dict[str, float]  # every parameter of the chain (free and held)
-    uncertainty: dict[str, float]  # free parameters only
+    uncertainty: dict[str, float]  # free parameters only, 1 sigma, SI
+    interval: dict[str, tuple[float, float]]  # free parameters only, 95 %, SI
+    identified: dict[str, bool]  # free parameters only
     free: tuple[str, ...]
     rmse: float  # N, over the fitted samples
     max_error: float  # N, over the fitted samples
-    samples: int  # fitted samples (measured ones minus those next to a jump)
-    contact: ContactConfig  # the base contact with the fitted values
+    noise: float  # N, the record's noise level
+    r2: float  # coefficient of determination over the fitted samples
+    samples: int  # fitted samples
+    contact: ContactConfig  # the base contact with the fitted values (its own numerics)
+    model_contact: ContactConfig  # the same on the fit's grid (what the fit ran)
+    used: NDArray[np.bool_]  # (m,) measured samples in the residuals
+    status: str  # "ok" or "unidentified" (some parameter not identified)
+    reason: str  # empty, or which parameters the record cannot fix and why
+    model_runs: int
+    wall_time: float  # s
+    bounds: dict[str, tuple[float, float]] = field(default_factory=dict)  # the box, SI
+    #: Largest Gauss-Newton step the secant model still proposes at the result, in standard
+    #: deviations of the parameter (the stationarity test's number).
+    stationarity: float = 0.0
+    model_time: float = 0.0  # s of wall_time spent running the model
 
-
-def _identify_checks(experiment: Experiment, free: Sequence[str]) -> None:
-    if experiment.measured_force.size < len(free) + 2:
-        raise FitError(f"{experiment.measured_force.size} force samples cannot fit {len(free)} parameters")
-    if "work_of_adhesion" in free and not has_pull_off(experiment.measured_force):
-        raise FitError(
-            "work_of_adhesion cannot be identified: the record holds no pull-off (a tensile force "
-            "released back to zero); hold it (leave it out of --free) or record a retraction"
+    def row(self) -> dict[str, Any]:
+        """One flat summary row (the batch runner's table): every value, its interval and
+        standard deviation, the fit error against the noise, status and time."""
+        row: dict[str, Any] = {"status": self.status, "reason": self.reason}
+        for name, value in self.values.items():
+            row[name] = value
+            if name in self.interval:
+                row[f"{name}_lo95"], row[f"{name}_hi95"] = self.interval[name]
+                row[f"{name}_sigma"] = self.uncertainty[name]
+                row[f"{name}_identified"] = self.identified[name]
+        row.update(
+            rmse_N=self.rmse,
+            noise_N=self.noise,
+            r2=self.r2,
+            samples=self.samples,
+            model_runs=self.model_runs,
+            wall_time_s=self.wall_time,
         )
-    if np.any(experiment.input_mode != 0):
+        return row
+
+
+def noise_level(force: NDArray[np.float64]) -> float:
+    """Standard deviation of white noise on ``force`` (N), robust to the signal: from the
+    median absolute deviation of the second differences (``var(d2) = 6 sigma^2``)."""
+    if force.size < 4:
+        return 0.0
+    d2 = np.diff(force, 2)
+    return 1.4826 * float(np.median(np.abs(d2 - np.median(d2)))) / math.sqrt(6.0)
+
+
+def _noise_floor(force: NDArray[np.float64]) -> float:
+    """The noise level, never below 1e-6 of max|F| (a noiseless synthetic record)."""
+    return max(noise_level(force), 1e-6 * float(np.max(np.abs(force))), 1e-300)
+
+
+def has_pull_off(force: NDArray[np.float64]) -> bool:
+    """True if ``force`` (N, > 0 compressive) becomes tensile beyond its noise and later
+    stays at zero within it for PULL_OFF_FREE_SAMPLES samples in a row: the contact was
+    pulled off (a reload that only crosses zero is not)."""
+    if force.size < 4:
+        return False
+    band = PULL_OFF_NOISE_BAND * _noise_floor(force)
+    lowest = int(np.argmin(force))
+    if not force[lowest] < -band:
+        return False
+    free = np.abs(force[lowest + 1 :]) <= band
+    run = np.convolve(free.astype(np.int64), np.ones(PULL_OFF_FREE_SAMPLES, dtype=np.int64), "valid")
+    return bool(run.size and np.max(run) >= PULL_OFF_FREE_SAMPLES)
+
+
+def smooth_samples(
+    force: NDArray[np.float64], noise: float | None = None, depth: NDArray[np.float64] | None = None
+) -> NDArray[np.bool_]:
+    """Mask of the samples of a measured force away from its jumps (snap-in, pull-off).
+
+    With ``depth`` (m, at the force samples): a jump is a change beyond JUMP_NOISE noise
+    deviations of a change against the depth's own change (the force rises while the depth
+    falls, or falls while it rises: an unstable branch), or a release from tension to zero
+    at a held depth. A steep ramp, a reversal or a fast relaxation is never one, however
+    coarsely sampled. Without ``depth``: a change beyond JUMP_NOISE deviations and three
+    times the median of its four neighbours' changes. JUMP_MARGIN samples either side go too.
+    """
+    keep = np.ones(force.size, dtype=bool)
+    if force.size < 5:
+        return keep
+    sigma = _noise_floor(force) if noise is None else noise
+    change = np.diff(force)
+    large = np.abs(change) > JUMP_NOISE * math.sqrt(2.0) * sigma
+    if depth is not None:
+        moved = np.diff(depth)
+        band = PULL_OFF_NOISE_BAND * sigma
+        released = (moved == 0.0) & (force[:-1] < -band) & (np.abs(force[1:]) <= band)
+        jumps = large & ((change * moved < 0.0) | released)
+    else:
+        padded = np.pad(np.abs(change), 2, mode="edge")
+        neighbours = np.stack([padded[:-4], padded[1:-3], padded[3:-1], padded[4:]])
+        jumps = large & (np.abs(change) > 3.0 * np.median(neighbours, axis=0))
+    for jump in np.flatnonzero(jumps):
+        keep[max(jump - JUMP_MARGIN, 0) : jump + 1 + JUMP_MARGIN + 1] = False
+    return keep
+
+
+def segment_samples(experiment: Experiment, options: FitOptions) -> NDArray[np.bool_]:
+    """Measured samples of the chosen segment and time range (see `FitOptions`)."""
+    t = experiment.time(experiment.measured_ns)
+    keep = np.ones(t.size, dtype=bool)
+    if options.time_range is not None:
+        t0, t1 = options.time_range
+        keep &= (t >= t0) & (t <= t1)
+    if options.segment != "both":
+        t_in = experiment.time(experiment.input_ns)
+        # Direction of the last depth change before (or at) each measured stamp.
+        moves = np.flatnonzero(np.diff(experiment.input_value) != 0.0)
+        direction = np.zeros(t_in.size)
+        direction[moves + 1] = np.sign(np.diff(experiment.input_value)[moves])
+        last_move = np.maximum.accumulate(np.where(direction != 0.0, np.arange(t_in.size), 0))
+        held = direction[last_move]
+        at = np.searchsorted(t_in, t, side="right") - 1
+        state = np.where(at >= 0, held[np.maximum(at, 0)], 0.0)
+        # A sample between two inputs belongs to the move towards the next one.
+        nxt = np.minimum(at + 1, t_in.size - 1)
+        towards = np.sign(experiment.input_value[nxt] - experiment.input_value[np.maximum(at, 0)])
+        state = np.where(towards != 0.0, towards, state)
+        keep &= state > 0.0 if options.segment == "approach" else state < 0.0
+    return keep
+
+
+def fit_grid(
+    contact: ContactConfig, experiment: Experiment, bounds: dict[str, tuple[float, float]]
+) -> tuple[float, int]:
+    """``(domain_radius m, elements)`` of the fit's one grid (see the module docstring):
+    :data:`GRID_MARGIN` times the largest contact radius any trial in ``bounds`` can reach
+    at the record's deepest point, with the preset's elements scaled up (at most
+    :data:`MAX_ELEMENT_FACTOR` times) so the start's contact keeps its resolution."""
+    from viscoadh_ros.core.criterion import critical_glass_elongation
+    from viscoadh_ros.core.presets import resolve_numerics
+    from viscoadh_ros.core.profiles import make_profile
+    from viscoadh_ros.core.rheology import CreepElement
+
+    profile = make_profile(contact.indenter)
+    deepest = float(np.max(experiment.input_value))
+    e0 = CreepElement.from_config(contact.material).glass_modulus_star
+    g0 = float(contact.material.glass_shear_modulus)
+    w = float(contact.adhesion.work_of_adhesion)
+
+    def reach(g0_trial: float, w_trial: float) -> float:
+        c = float(critical_glass_elongation(1.0, w_trial, e0 * g0_trial / g0)) if w_trial > 0 else 0.0
+
+        def excess(a: float) -> float:
+            return float(profile.g(a)) - deepest - c * math.sqrt(a)
+
+        lo, hi = 1e-12, max(1e-9, float(profile.radius_at_height(max(deepest, 0.0))))
+        while excess(hi) < 0.0 and hi < 1e3:
+            hi *= 2.0
+        for _ in range(200):
+            mid = math.sqrt(lo * hi)
+            lo, hi = (mid, hi) if excess(mid) < 0.0 else (lo, mid)
+            if hi <= lo * (1.0 + 1e-9):
+                break
+        return hi
+
+    g0_lo = bounds.get("G0", (g0, g0))[0]
+    w_hi = bounds.get("work_of_adhesion", (w, w))[1]
+    largest, at_start = reach(g0_lo, w_hi), reach(g0, w)
+    elements = resolve_numerics(contact.numerics).elements
+    factor = min(max(largest / at_start, 1.0), MAX_ELEMENT_FACTOR)
+    return GRID_MARGIN * largest, int(math.ceil(elements * factor))
+
+
+class _Problem:
+    """The residuals of one fit: the model on the fit's grid at the used samples, in noise units."""
+
+    def __init__(
+        self,
+        contact: ContactConfig,
+        experiment: Experiment,
+        free: Sequence[str],
+        kelvin: int,
+        start: dict[str, float],
+        used: NDArray[np.bool_],
+        noise: float,
+        runs: int = 0,
+    ) -> None:
+        self.contact, self.experiment, self.free, self.kelvin = contact, experiment, tuple(free), kelvin
+        self.start, self.used, self.noise = start, used, noise
+        self.measured = experiment.measured_force[used]
+        self.runs = runs
+        self.model_time = 0.0  # s spent in run_model
+
+    def values(self, u: NDArray[np.float64]) -> dict[str, float]:
+        trial = dict(self.start)
+        trial.update({n: self.start[n] * math.exp(float(x)) for n, x in zip(self.free, u, strict=True)})
+        return trial
+
+    def force(self, u: NDArray[np.float64], contact: ContactConfig | None = None) -> NDArray[np.float64]:
+        """Model force (N) at the used samples for log-ratios ``u``."""
+        self.runs += 1
+        base = self.contact if contact is None else contact
+        started = wallclock.perf_counter()
+        try:
+            run = run_model(with_parameters(base, self.values(u), self.kelvin), self.experiment)
+        except ValueError:
+            # Outside what the model accepts: a large residual steers the optimiser back.
+            return self.measured + 1e3 * self.noise * math.sqrt(self.measured.size)
+        finally:
+            self.model_time += wallclock.perf_counter() - started
+        return run.model_force[self.used]
+
+    def residual(self, u: NDArray[np.float64]) -> NDArray[np.float64]:
+        return (self.force(u) - self.measured) / self.noise
+
+    def secant(self, u: NDArray[np.float64], steps: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Central-secant Jacobian of the residuals over +-``steps[j]`` in each u."""
+        columns = []
+        for h, e in zip(steps, np.eye(u.size), strict=True):
+            columns.append((self.residual(u + h * e) - self.residual(u - h * e)) / (2.0 * h))
+        return np.column_stack(columns)
+
+
+def _identify_checks(
+    experiment: Experiment, free: Sequence[str], used: NDArray[np.bool_], selected: NDArray[np.bool_]
+) -> None:
+    if np.any(experiment.input_mode != DEPTH):
         raise FitError("fit needs depth-controlled inputs; the record holds FORCE-mode commands")
+    if int(np.count_nonzero(used)) < len(free) + 2:
+        raise FitError(
+            f"{int(np.count_nonzero(used))} force samples (after the segment, time range and jump "
+            f"masks) cannot fit {len(free)} parameters"
+        )
+    if "work_of_adhesion" in free and not has_pull_off(experiment.measured_force[selected]):
+        raise FitError(
+            "work_of_adhesion cannot be identified: the fitted samples hold no pull-off (a tensile "
+            "force released back to zero); hold it (leave it out of --free) or record a retraction"
+        )
+
+
+def _difference_step(problem: _Problem, u: NDArray[np.float64]) -> float:
+    """The smallest forward-difference step (in u) at which the Jacobian agrees with the one
+    four times wider within 30 % in every column: below it what roughness remains (element
+    and sample crossings) would read as slope."""
+    base = problem.residual(u)
+    for step in (1e-3, 1e-2):
+        agree = True
+        for e in np.eye(u.size):
+            near = (problem.residual(u + step * e) - base) / step
+            far = (problem.residual(u + 4.0 * step * e) - base) / (4.0 * step)
+            if np.linalg.norm(near - far) > 0.3 * max(float(np.linalg.norm(far)), 1e-12):
+                agree = False
+                break
+        if agree:
+            return step
+    return 3e-2
+
+
+def _covariance(
+    jac: NDArray[np.float64], s2: float, free: Sequence[str]
+) -> tuple[NDArray[np.float64], list[str]]:
+    """Covariance of u and the parameters that only act together (a null direction) or
+    not at all; those get infinite variance."""
+    norms = np.linalg.norm(jac, axis=0)
+    top = max(float(np.max(norms)), 1e-300)
+    dead = norms <= 1e-12 * top
+    cov = np.full((len(free), len(free)), np.inf)
+    flat: set[str] = {n for n, d in zip(free, dead, strict=True) if d}
+    live = np.flatnonzero(~dead)
+    if live.size:
+        scaled = jac[:, live] / norms[live]
+        _, singular, vt = np.linalg.svd(scaled, full_matrices=False)
+        null = singular < singular[0] / MAX_CONDITION
+        for vec in vt[null]:
+            flat.update(free[live[j]] for j in np.flatnonzero(np.abs(vec) > 0.3))
+        inv = (vt[~null].T / singular[~null] ** 2) @ vt[~null]
+        sub = s2 * inv / np.outer(norms[live], norms[live])
+        cov[np.ix_(live, live)] = sub
+    for j, name in enumerate(free):
+        if name in flat:
+            cov[j, j] = np.inf
+    return cov, sorted(flat, key=list(free).index)
+
+
+@dataclass(frozen=True)
+class _Polished:
+    u: NDArray[np.float64]
+    cov: NDArray[np.float64]
+    flat: list[str]
+    sigmas: NDArray[np.float64]  # the last proposed step, in standard deviations
+    steps: NDArray[np.float64]  # the last secant's half-widths
+
+    @property
+    def sigma_u(self) -> NDArray[np.float64]:
+        return np.sqrt(np.diag(self.cov))
+
+
+def _polish(
+    problem: _Problem,
+    u: NDArray[np.float64],
+    lower: NDArray[np.float64],
+    upper: NDArray[np.float64],
+    smallest: float,
+    steps: NDArray[np.float64] | None = None,
+) -> _Polished:
+    """Gauss-Newton on the central-secant model from ``u`` until the step it proposes is
+    below POLISH_SIGMAS standard deviations (at most POLISH_STEPS). Each secant spans
+    SECANT_SIGMAS standard deviations of its parameter (the last covariance's): wide against
+    what roughness remains, narrow against the curvature (a central secant's fixed point is
+    off the optimum by its width squared times the third derivative)."""
+    free, p = problem.free, u.size
+    dof = max(problem.measured.size - p, 1)
+    r = problem.residual(u)
+    steps = np.full(p, SECANT_STEP) if steps is None else steps
+    sigmas = np.zeros(p)
+    for _ in range(POLISH_STEPS):
+        jac = problem.secant(u, steps)
+        cov, flat = _covariance(jac, float(r @ r) / dof, free)
+        sigma_u = np.sqrt(np.diag(cov))
+        narrower = np.clip(
+            np.nan_to_num(SECANT_SIGMAS * sigma_u, nan=SECANT_STEP, posinf=SECANT_STEP), smallest, SECANT_STEP
+        )
+        if np.any(narrower < 0.5 * steps):
+            steps = narrower  # the first, wide secant only sizes the next
+            continue
+        steps = narrower
+        gn = np.linalg.lstsq(jac, -r, rcond=None)[0]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            sigmas = np.where(np.isfinite(sigma_u), np.abs(gn) / sigma_u, 0.0)
+        if float(np.max(sigmas)) <= POLISH_SIGMAS:
+            break
+        if np.all((np.abs(gn) <= POLISH_TRUST * sigma_u) | (np.abs(gn) <= steps)):
+            # Within a few standard deviations, or within the secant's own span, the secant
+            # model is the judge: what roughness remains moves the cost at a single trial
+            # point by about one unit.
+            u = np.clip(u + gn, lower, upper)
+            r = problem.residual(u)
+            continue
+        for fraction in (1.0, 0.5, 0.25):
+            trial = np.clip(u + fraction * gn, lower, upper)
+            r_trial = problem.residual(trial)
+            if r_trial @ r_trial < r @ r:
+                u, r = trial, r_trial
+                break
+        else:
+            break
+    return _Polished(u, cov, flat, sigmas, steps)
 
 
 def fit(
@@ -174,137 +593,264 @@ def fit(
     free: Sequence[str],
     *,
     kelvin: int = 1,
+    options: FitOptions | None = None,
 ) -> FitResult:
     """Fit the ``free`` parameters of ``contact`` (``kelvin`` Kelvin elements) to ``experiment``.
 
-    Raises FitError when a parameter is not identified by the data.
+    Raises FitError when the record cannot say anything about a free parameter or the fit
+    does not reach a stationary point; a parameter it cannot pin down is reported as not
+    identified with its interval (`FitResult.identified`).
     """
-    _identify_checks(experiment, free)
-    values = initial_values(contact, kelvin)
+    started = wallclock.perf_counter()
+    options = options or FitOptions()
+    free = list(free)
+    if experiment.measured_force.size < 5:
+        raise FitError(f"{experiment.measured_force.size} force samples cannot fit {len(free)} parameters")
+    start = initial_values(contact, kelvin)
     for name in free:
-        if not values[name] > 0.0 or not math.isfinite(values[name]):
-            raise InputError(f"start value of {name} must be finite and > 0 (got {values[name]})")
-    usable = smooth_samples(experiment.measured_force)
-    measured = experiment.measured_force[usable]
-    scale = float(np.max(np.abs(measured)))
-
-    def model(
-        base: dict[str, float], theta: NDArray[np.float64], names: Sequence[str]
-    ) -> NDArray[np.float64]:
-        trial = dict(base)
-        trial.update({n: float(math.exp(t)) for n, t in zip(names, theta, strict=True)})
-        try:
-            return run_model(with_parameters(contact, trial, kelvin), experiment).model_force[usable]
-        except ValueError:
-            # The optimiser stepped outside what the model accepts: a large residual steers it back.
-            return np.full(measured.shape, 1e3 * scale)
-
-    stage1 = [n for n in free if n != "work_of_adhesion"]
-    compressive = measured > 0.0
-    staged = bool(stage1) and "work_of_adhesion" in free and np.count_nonzero(compressive) > len(stage1) + 1
-
-    def descend(start: dict[str, float]) -> tuple[OptimizeResult, dict[str, float]]:
-        """Both stages from ``start``: the optimum and every parameter's value there."""
-        start = dict(start)
-        if staged:
-            first = least_squares(
-                lambda th: (model(start, th, stage1)[compressive] - measured[compressive]) / scale,
-                np.log([start[n] for n in stage1]),
-                diff_step=1e-4,
-                x_scale=1.0,
-            )
-            start.update({n: float(math.exp(t)) for n, t in zip(stage1, first.x, strict=True)})
-        x0 = np.log([start[n] for n in free])
-        found = least_squares(
-            lambda th: (model(start, th, free) - measured) / scale, x0, diff_step=1e-4, x_scale=1.0
-        )
-        start.update({n: float(math.exp(t)) for n, t in zip(free, found.x, strict=True)})
-        return found, start
-
-    # The glass modulus shows only in the fastest parts of a record, so with the Kelvin chain
-    # free a descent can stop in a valley far from it: start also from G0 halved and doubled
-    # and keep the lowest cost.
-    factors = G0_START_FACTORS if "G0" in free and len(free) > 1 else (1.0,)
-    descents = [descend({**values, "G0": values["G0"] * f}) for f in factors]
-    result, values = min(descents, key=lambda d: d[0].cost)
-    if not result.success:
-        raise FitError(f"the fit did not converge: {result.message}")
-    secant = np.column_stack(
-        [
-            (
-                model(values, result.x + SECANT_STEP * e, free)
-                - model(values, result.x - SECANT_STEP * e, free)
-            )
-            / (2 * SECANT_STEP * scale)
-            for e in np.eye(len(free))
-        ]
+        if not start[name] > 0.0 or not math.isfinite(start[name]):
+            raise InputError(f"start value of {name} must be finite and > 0 (got {start[name]})")
+    noise = _noise_floor(experiment.measured_force)
+    depth = np.interp(
+        experiment.time(experiment.measured_ns), experiment.time(experiment.input_ns), experiment.input_value
     )
-    sigma = _uncertainty(secant, result.fun, free)
-    residual = result.fun * scale
+    selected = segment_samples(experiment, options)
+    used = smooth_samples(experiment.measured_force, noise, depth) & selected
+    _identify_checks(experiment, free, used, selected)
+
+    half = math.log(options.bounds_factor)
+    bounds = {n: (start[n] / options.bounds_factor, start[n] * options.bounds_factor) for n in free}
+    domain, elements = fit_grid(contact, experiment, bounds)
+    numerics = dataclasses.replace(contact.numerics, domain_radius=domain, elements=elements)
+    grid_contact = dataclasses.replace(contact, numerics=numerics)
+    problem = _Problem(grid_contact, experiment, free, kelvin, start, used, noise)
+    p = len(free)
+    lower, upper = np.full(p, -half), np.full(p, half)
+
+    def cost(u: NDArray[np.float64]) -> float:
+        r = problem.residual(u)
+        return 0.5 * float(r @ r)
+
+    step = _difference_step(problem, np.zeros(p))
+
+    def descend(u0: NDArray[np.float64]) -> tuple[NDArray[np.float64], float]:
+        found = least_squares(
+            problem.residual,
+            np.clip(u0, lower + 1e-9, upper - 1e-9),
+            bounds=(lower, upper),
+            diff_step=step,
+            x_scale=1.0,
+            max_nfev=DESCENT_EVALUATIONS,
+        )
+        return found.x, float(found.cost)
+
+    # The start's descent; when its fit error is above the noise (a local valley, or model
+    # error), the global stage: the cost at seeded Sobol points of the box and descents from
+    # the best of them; the lowest cost wins.
+    u, best = descend(np.zeros(p))
+    dof = max(problem.measured.size - p, 1)
+    if 2.0 * best / dof > 1.0 + NOISE_CONSISTENT * math.sqrt(2.0 / dof):
+        sobol = qmc.Sobol(d=p, scramble=True, seed=options.seed).random(GLOBAL_POINTS)
+        candidates = [lower + (upper - lower) * s for s in sobol]
+        costs = [cost(c) for c in candidates]
+        descents = [descend(candidates[i]) for i in np.argsort(costs)[:GLOBAL_DESCENTS]]
+        u, best = min([(u, best), *descents], key=lambda d: d[1])
+
+    # Polish on the secant model, then again on grids refined by 2 until the optimum stops
+    # moving: the last shift is the discretisation's model-error term.
+    smallest = max(step / 3.0, MIN_SECANT)
+    model_time = 0.0
+    polished = _polish(problem, u, lower, upper, smallest)
+    if float(np.max(polished.sigmas)) > STATIONARY_SIGMAS:
+        # The polish stopped on a rough patch: descend once more from where it got to.
+        polished = _polish(problem, descend(polished.u)[0], lower, upper, smallest)
+    shift = np.zeros(p)
+    for _ in range(MAX_REFINEMENTS):
+        elements *= 2
+        finer = dataclasses.replace(grid_contact, numerics=dataclasses.replace(numerics, elements=elements))
+        model_time += problem.model_time
+        problem = _Problem(finer, experiment, free, kelvin, start, used, noise, runs=problem.runs)
+        refined = _polish(problem, polished.u, lower, upper, smallest, polished.steps)
+        shift, polished = refined.u - polished.u, refined
+        if np.all(np.abs(shift) <= REFINED_SIGMAS * polished.sigma_u):
+            break
+    u, cov, flat, sigmas = polished.u, polished.cov, polished.flat, polished.sigmas
+    model_contact = problem.contact
+    worst = int(np.argmax(sigmas))
+    if sigmas[worst] > STATIONARY_SIGMAS:
+        raise FitError(
+            f"the fit did not converge: at its end the secant still proposes a step of "
+            f"{sigmas[worst]:.1f} standard deviations in {free[worst]}"
+        )
+    sigma_u = np.sqrt(np.diag(cov) + shift**2)
+
+    values = problem.values(u)
+    uncertainty, interval, identified = {}, {}, {}
+    for j, name in enumerate(free):
+        s = float(sigma_u[j])
+        identified[name] = name not in flat and s <= MAX_RELATIVE_UNCERTAINTY
+        lo = max(u[j] - Z95 * s, -half) if math.isfinite(s) else -half
+        hi = min(u[j] + Z95 * s, half) if math.isfinite(s) else half
+        interval[name] = (start[name] * math.exp(lo), start[name] * math.exp(hi))
+        uncertainty[name] = values[name] * s if math.isfinite(s) else math.inf
+    unidentified = [n for n in free if not identified[n]]
+    reason = ""
+    if unidentified:
+        together = [n for n in unidentified if n in flat]
+        reason = (
+            f"{', '.join(unidentified)} not identified by this record"
+            + (f" ({', '.join(together)} only act together)" if len(together) > 1 else "")
+            + ": the interval is what it can say (a viscosity needs a change of rate or a hold; "
+            "G0 loading as fast as the relaxation; the work of adhesion a pull-off)"
+        )
+    force = problem.force(u)
+    error = force - problem.measured
+    spread = float(np.sum((problem.measured - np.mean(problem.measured)) ** 2))
     return FitResult(
         values=values,
-        uncertainty={n: values[n] * s for n, s in zip(free, sigma, strict=True)},
+        uncertainty=uncertainty,
+        interval=interval,
+        identified=identified,
         free=tuple(free),
-        rmse=float(np.sqrt(np.mean(residual**2))),
-        max_error=float(np.max(np.abs(residual))),
-        samples=int(measured.size),
+        rmse=float(np.sqrt(np.mean(error**2))),
+        max_error=float(np.max(np.abs(error))),
+        noise=noise,
+        r2=1.0 - float(error @ error) / spread if spread > 0 else float("nan"),
+        samples=int(problem.measured.size),
         contact=with_parameters(contact, values, kelvin),
+        model_contact=with_parameters(model_contact, values, kelvin),
+        used=used,
+        status="unidentified" if unidentified else "ok",
+        reason=reason,
+        model_runs=problem.runs,
+        wall_time=wallclock.perf_counter() - started,
+        bounds=bounds,
+        stationarity=float(sigmas[worst]),
+        model_time=model_time + problem.model_time,
     )
 
 
-def has_pull_off(force: NDArray[np.float64]) -> bool:
-    """True if ``force`` (N, > 0 compressive) becomes tensile beyond its noise and later
-    returns to zero within it: the contact was pulled off. Noise is estimated robustly from the
-    sample-to-sample changes (median absolute deviation)."""
-    if force.size < 3:
-        return False
-    change = np.diff(force)
-    noise = 1.4826 * float(np.median(np.abs(change - np.median(change)))) / math.sqrt(2.0)
-    band = PULL_OFF_NOISE_BAND * noise
-    lowest = int(np.argmin(force))
-    return bool(force[lowest] < -band and np.any(np.abs(force[lowest + 1 :]) <= band))
+#: Keys of `fit_file`'s options, with their defaults.
+FILE_OPTIONS: dict[str, Any] = {
+    "scene": None,  # start scene YAML path; None: the scene stored in the bag by the node
+    "contact": None,
+    "depth_topic": None,
+    "force_topic": None,
+    "flip_force": False,
+    "recover": False,
+    "free": None,  # "G0,work_of_adhesion" or a list; None: every parameter of the chain
+    "kelvin": 1,
+    "segment": "both",
+    "time_range": None,  # [t0, t1] s since the first input
+    "bounds_factor": BOUNDS_FACTOR,
+    "seed": 0,
+    "output": None,  # fitted scene YAML to write (+ its report beside it); None: write nothing
+    "report": True,
+}
 
 
-def smooth_samples(force: NDArray[np.float64]) -> NDArray[np.bool_]:
-    """Mask of the samples of a measured force away from its jumps (see the module docstring)."""
-    keep = np.ones(force.size, dtype=bool)
-    if force.size < 3:
-        return keep
-    change = np.abs(np.diff(force))
-    threshold = max(JUMP_FRACTION * float(np.max(np.abs(force))), 10.0 * float(np.median(change)))
-    for jump in np.flatnonzero(change > threshold):
-        keep[max(jump - JUMP_MARGIN, 0) : jump + 1 + JUMP_MARGIN + 1] = False
-    return keep
+@dataclass(frozen=True)
+class FileFit:
+    """What `fit_bag` fitted: the result, the record and the scene it came from."""
+
+    result: FitResult
+    experiment: Experiment
+    scene: Any  # SceneConfig with the fitted contact
+    contact_id: str
+    written: tuple[str, ...]  # paths written (scene, figure, table)
 
 
-def _uncertainty(
-    jac: NDArray[np.float64], fun: NDArray[np.float64], free: Sequence[str]
-) -> NDArray[np.float64]:
-    """Standard deviations of the log-parameters; FitError for unidentified ones."""
-    norms = np.linalg.norm(jac, axis=0)
-    dead = [n for n, c in zip(free, norms, strict=True) if not c > 1e-12 * max(float(np.max(norms)), 1e-300)]
-    if dead:
-        raise FitError(
-            f"{', '.join(dead)} cannot be identified: the force does not depend on it in this record"
+def fit_bag(path: str, options: dict[str, Any]) -> FileFit:
+    """Fit one bag with `FILE_OPTIONS`-style ``options``; writes the fitted scene and its
+    report when ``options["output"]`` is set. Raises InputError (FitError) on user errors."""
+    from pathlib import Path
+
+    import yaml
+
+    from viscoadh_ros.core.config import SceneConfig
+    from viscoadh_ros.experiment import choose_contact, load_experiment
+    from viscoadh_ros.io.bag import Bag
+    from viscoadh_ros.io.mcap_log import plain
+
+    unknown = sorted(set(options) - set(FILE_OPTIONS))
+    if unknown:
+        raise InputError(f"unknown fit option(s) {unknown}; known: {sorted(FILE_OPTIONS)}")
+    opts = {**FILE_OPTIONS, **options}
+    kelvin = int(opts["kelvin"])
+    if kelvin < 1:
+        raise InputError(f"kelvin must be >= 1 (got {kelvin})")
+    free_text = opts["free"]
+    if isinstance(free_text, (list, tuple)):
+        free_text = ",".join(free_text)
+    free = parse_free(free_text, kelvin) if free_text else parameter_names(kelvin)
+    time_range = opts["time_range"]
+    fit_options = FitOptions(
+        segment=opts["segment"],
+        time_range=None if time_range is None else (float(time_range[0]), float(time_range[1])),
+        bounds_factor=float(opts["bounds_factor"]),
+        seed=int(opts["seed"]),
+    )
+    bag = Bag(path, recover=bool(opts["recover"]))
+    experiment = load_experiment(
+        bag,
+        input_topic=opts["depth_topic"],
+        force_topic=opts["force_topic"],
+        contact=opts["contact"],
+        flip_force=bool(opts["flip_force"]),
+    )
+    if experiment.force_topic is None:
+        raise InputError(
+            f"no measured force in {str(path)!r}: record a WrenchStamped or name a Float64 force "
+            f"with --force-topic (topics: {bag.topics})"
         )
-    scaled = jac / norms
-    _, singular, vt = np.linalg.svd(scaled, full_matrices=False)
-    if singular[-1] <= 0 or singular[0] / singular[-1] > MAX_CONDITION:
-        involved = [n for n, v in zip(free, vt[-1], strict=True) if abs(v) > 0.3]
-        raise FitError(
-            f"{', '.join(involved)} cannot be identified separately from this record (they only act "
-            "together; a viscosity needs a change of rate or a hold); fix one of them"
-        )
-    dof = max(fun.size - len(free), 1)
-    s2 = float(fun @ fun) / dof
-    cov = s2 * np.linalg.inv(jac.T @ jac)
-    sigma = np.sqrt(np.clip(np.diag(cov), 0.0, None))
-    vague = [
-        f"{n} (+-{100 * s:.0f}%)" for n, s in zip(free, sigma, strict=True) if s > MAX_RELATIVE_UNCERTAINTY
-    ]
-    if vague:
-        raise FitError(
-            f"{', '.join(vague)} not identified by this record (a viscosity needs a change of rate "
-            "or a hold; the work of adhesion a pull-off); fix it or record more"
-        )
-    return sigma
+    if opts["scene"] is not None:
+        scene = SceneConfig.from_yaml(opts["scene"])
+    else:
+        stored = bag.scene()
+        if stored is None:
+            raise InputError(f"{str(path)!r} stores no scene (not a log of our node); pass --scene")
+        scene = SceneConfig.from_dict(stored)
+    contact = choose_contact(scene, opts["contact"], experiment.input_topic)
+    result = fit(contact, experiment, free, kelvin=kelvin, options=fit_options)
+    contacts = tuple(result.contact if c.id == contact.id else c for c in scene.contacts)
+    fitted = dataclasses.replace(scene, contacts=contacts)
+    written: list[str] = []
+    if opts["output"] is not None:
+        output = Path(opts["output"])
+        output.parent.mkdir(parents=True, exist_ok=True)
+        output.write_text(yaml.safe_dump(plain(fitted.to_dict()), sort_keys=False), encoding="utf-8")
+        written.append(str(output))
+        if opts["report"]:
+            from viscoadh_ros.fit_report import write_report
+
+            title = f"{contact.id} from {Path(path).name} ({experiment.force_topic})"
+            written.extend(str(p) for p in write_report(result, experiment, output, title=title))
+    return FileFit(result, experiment, fitted, contact.id, tuple(written))
+
+
+def fit_file(path: str, options: dict[str, Any]) -> dict[str, Any]:
+    """One summary row for the bag at ``path`` (the batch runner's unit of work; picklable,
+    top level): ``bag``, ``contact``, ``status`` (``ok``, ``unidentified`` or ``failed``),
+    ``reason``, every fitted value with its 95 % interval (``<name>_lo95``/``_hi95``), standard
+    deviation (``<name>_sigma``) and ``<name>_identified``, ``rmse_N``, ``noise_N``, ``r2``,
+    ``samples``, ``model_runs``, ``wall_time_s`` and the files written. ``options`` as
+    `FILE_OPTIONS`. Never raises: a bag that cannot be fitted is a row with status
+    ``failed`` and the reason."""
+    started = wallclock.perf_counter()
+    try:
+        done = fit_bag(path, options)
+    except Exception as exc:  # noqa: BLE001 - a batch row, never a lost batch
+        reason = " ".join(str(exc).split()) or type(exc).__name__
+        if not isinstance(exc, ValueError):
+            reason = f"{type(exc).__name__}: {reason}"
+        return {
+            "bag": str(path),
+            "contact": options.get("contact"),
+            "status": "failed",
+            "reason": reason,
+            "wall_time_s": wallclock.perf_counter() - started,
+        }
+    row = {"bag": str(path), "contact": done.contact_id, **done.result.row()}
+    row["wall_time_s"] = wallclock.perf_counter() - started
+    row["written"] = ";".join(done.written)
+    return row

@@ -9,7 +9,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-SECTIONS = ("kernel", "accuracy", "node", "replay", "batch", "gripper")
+SECTIONS = ("kernel", "accuracy", "node", "replay", "batch", "gripper", "fit")
 #: The results keys each section writes (the soak is asked for by --soak, not --sections); a
 #: merge replaces exactly these.
 SECTION_KEYS = {
@@ -19,6 +19,7 @@ SECTION_KEYS = {
     "replay": ("replay",),
     "batch": ("batch",),
     "gripper": ("gripper",),
+    "fit": ("fit",),
     "soak": ("soak",),
 }
 #: Top-level keys that describe the run the report header names.
@@ -49,6 +50,9 @@ class Plan:
     batch_bags: int = 12
     batch_seconds: float = 20.0
     batch_workers: tuple[int, ...] = (1, 2)
+    fit_samples: int = 5000
+    fit_starts: int = 4
+    fit_kelvin_starts: int = 1
 
 
 FULL = Plan(
@@ -90,6 +94,9 @@ QUICK = Plan(
     gripper_pads=(1, 4, 16),
     gripper_seconds=0.3,
     gripper_repeats=1,
+    fit_samples=1000,
+    fit_starts=2,
+    fit_kelvin_starts=1,
 )
 
 
@@ -178,6 +185,13 @@ def run(
         progress(f"gripper: {plan.gripper_seconds:g} s of the MuJoCo cell, library then node")
         results["gripper"] = gripper_benchmark(
             pads=plan.gripper_pads, seconds=plan.gripper_seconds, repeats=plan.gripper_repeats
+        )
+    if "fit" in sections:
+        from viscoadh_ros.bench.fit_speed import fit_benchmark
+
+        progress(f"fit: {plan.fit_starts} + {plan.fit_kelvin_starts} fits, {plan.fit_samples} samples each")
+        results["fit"] = fit_benchmark(
+            samples=plan.fit_samples, starts=plan.fit_starts, kelvin_starts=plan.fit_kelvin_starts
         )
     if soak_minutes is not None:
         from viscoadh_ros.bench.soak import soak

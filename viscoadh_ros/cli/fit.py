@@ -2,29 +2,22 @@
 
 The indenter geometry and the start values come from ``--scene`` (or the scene stored in a
 log of our node); the result is that scene with the fitted material, as a ROS 2 parameters
-file the node and ``viscoadh replay`` accept.
+file the node and ``viscoadh replay`` accept, and beside it a report: ``SCENE.report.png``
+(measured and fitted force against time and depth, residuals, the fitted material's JKR
+branches) and ``SCENE.report.md`` (each value with its 95 % interval, RMSE and r^2 against the
+record's noise level). The same fit of one bag is `viscoadh_ros.fitting.fit_file` for batch
+runners.
 """
 
 from __future__ import annotations
 
 import argparse
-import dataclasses
 from pathlib import Path
 
-import yaml
-
 from viscoadh_ros.cli._paths import refuse_overwrite
-from viscoadh_ros.cli.replay import (
-    add_input_arguments,
-    batch_bags,
-    batch_main,
-    input_options,
-    open_experiment,
-)
+from viscoadh_ros.cli.replay import add_input_arguments, batch_bags, batch_main, input_options
 from viscoadh_ros.core.errors import InputError
-from viscoadh_ros.experiment import choose_contact
-from viscoadh_ros.fitting import fit, parameter_names, parse_free, unit_of
-from viscoadh_ros.io.mcap_log import plain
+from viscoadh_ros.fitting import BOUNDS_FACTOR, SEGMENTS, fit_bag, unit_of
 
 
 def _kelvin(text: str) -> int:
@@ -49,6 +42,28 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="number of Kelvin elements of the rheology (default 1: standard solid)",
     )
     parser.add_argument(
+        "--segment",
+        choices=SEGMENTS,
+        default="both",
+        help="fit the samples where the depth last moved in (approach), out (retract) or all (both)",
+    )
+    parser.add_argument(
+        "--time-range",
+        nargs=2,
+        type=float,
+        metavar=("T0", "T1"),
+        help="fit only the samples between T0 and T1, s since the first input (the model runs from 0)",
+    )
+    parser.add_argument(
+        "--bounds-factor",
+        type=float,
+        default=BOUNDS_FACTOR,
+        metavar="F",
+        help=f"search each free parameter within start/F .. start*F (default {BOUNDS_FACTOR:g})",
+    )
+    parser.add_argument("--seed", type=int, default=0, help="seed of the global search (default 0)")
+    parser.add_argument("--no-report", action="store_true", help="do not write the report beside SCENE")
+    parser.add_argument(
         "-o", "--output", type=Path, required=True, help="scene YAML to write (a folder in batch mode)"
     )
 
@@ -59,34 +74,69 @@ def main(args: argparse.Namespace) -> int:
         return _batch(args, bags)
     if args.output.suffix not in (".yaml", ".yml"):
         raise InputError(f"--output must be a .yaml file (got {str(args.output)!r})")
-    refuse_overwrite([args.bag, args.scene], [("--output", args.output)])
-    _, scene, experiment = open_experiment(args)
-    contact = choose_contact(scene, args.contact, experiment.input_topic)
-    free = parse_free(args.free, args.kelvin) if args.free else parameter_names(args.kelvin)
-    result = fit(contact, experiment, free, kelvin=args.kelvin)
-    contacts = tuple(result.contact if c.id == contact.id else c for c in scene.contacts)
-    fitted = dataclasses.replace(scene, contacts=contacts)
-    args.output.write_text(yaml.safe_dump(plain(fitted.to_dict()), sort_keys=False), encoding="utf-8")
+    from viscoadh_ros.fit_report import report_paths
 
-    print(f"fit of {contact.id} to {experiment.force_topic} ({result.samples} samples):")
+    outputs = [args.output] if args.no_report else [args.output, *report_paths(args.output)]
+    refuse_overwrite([args.bag, args.scene], [("--output", path) for path in outputs])
+    options = {
+        "scene": args.scene,
+        "contact": args.contact,
+        "depth_topic": args.depth_topic,
+        "force_topic": args.force_topic,
+        "flip_force": args.flip_force,
+        "recover": args.recover,
+        "free": args.free,
+        "kelvin": args.kelvin,
+        "segment": args.segment,
+        "time_range": args.time_range,
+        "bounds_factor": args.bounds_factor,
+        "seed": args.seed,
+        "output": args.output,
+        "report": not args.no_report,
+    }
+    done = fit_bag(str(args.bag), options)
+    result = done.result
+    print(
+        f"fit of {done.contact_id} to {done.experiment.force_topic} ({result.samples} samples, "
+        f"{result.model_runs} model runs, {result.wall_time:.3g} s):"
+    )
     for name, value in result.values.items():
-        if name in result.uncertainty:
-            sigma = result.uncertainty[name]
-            print(f"  {name:>16} = {value:.6g} +- {sigma:.2g} {unit_of(name)} ({100 * sigma / value:.2g}%)")
+        unit = unit_of(name)
+        if name not in result.uncertainty:
+            print(f"  {name:>16} = {value:.6g} {unit} (held)")
+            continue
+        sigma = result.uncertainty[name]
+        lo, hi = result.interval[name]
+        if result.identified[name]:
+            print(
+                f"  {name:>16} = {value:.6g} +- {sigma:.2g} {unit} ({100 * sigma / value:.2g}%; "
+                f"95% {lo:.4g} .. {hi:.4g})"
+            )
         else:
-            print(f"  {name:>16} = {value:.6g} {unit_of(name)} (held)")
-    print(f"fit error: RMSE {result.rmse:.6g} N, max {result.max_error:.6g} N\nwrote {args.output}")
+            print(f"  {name:>16}   NOT IDENTIFIED: 95% {lo:.4g} .. {hi:.4g} {unit} (best {value:.4g})")
+    print(
+        f"fit error: RMSE {result.rmse:.6g} N against noise level {result.noise:.6g} N "
+        f"(ratio {result.rmse / result.noise:.3g}), r^2 {result.r2:.6f}, max {result.max_error:.6g} N"
+    )
+    if result.reason:
+        print(f"warning: {result.reason}")
+    print("wrote " + ", ".join(done.written))
     return 0
 
 
 def _batch(args: argparse.Namespace, bags: list) -> int:
     """Many bags on a Dask cluster: ``fitting.fit_file(path, options)`` per bag (one summary
     row; it writes ``options["output"]``, the fitted scene, beside the others in OUTPUT)."""
-    import viscoadh_ros.fitting as fitting
-
-    if not hasattr(fitting, "fit_file"):
-        raise InputError("batch fit needs viscoadh_ros.fitting.fit_file, which this version lacks")
-    options = {**input_options(args), "free": args.free, "kelvin": args.kelvin}
+    options = {
+        **input_options(args),
+        "free": args.free,
+        "kelvin": args.kelvin,
+        "segment": args.segment,
+        "time_range": args.time_range,
+        "bounds_factor": args.bounds_factor,
+        "seed": args.seed,
+        "report": not args.no_report,
+    }
     return batch_main(
         "fit", args, bags, task="viscoadh_ros.fitting:fit_file", suffix=".fit.yaml", options=options
     )
