@@ -14,7 +14,7 @@ SECTIONS = ("kernel", "accuracy", "node", "replay", "batch", "gripper")
 #: merge replaces exactly these.
 SECTION_KEYS = {
     "kernel": ("kernel",),
-    "accuracy": ("accuracy", "presets"),
+    "accuracy": ("accuracy", "presets", "tolerance"),
     "node": ("node", "startup_s"),
     "replay": ("replay",),
     "batch": ("batch",),
@@ -49,6 +49,7 @@ class Plan:
     batch_bags: int = 12
     batch_seconds: float = 20.0
     batch_workers: tuple[int, ...] = (1, 2)
+    accuracy_tolerances: tuple[float, ...] = (1e-2, 1e-3, 1e-4)
 
 
 FULL = Plan(
@@ -90,6 +91,7 @@ QUICK = Plan(
     gripper_pads=(1, 4, 16),
     gripper_seconds=0.3,
     gripper_repeats=1,
+    accuracy_tolerances=(1e-2, 1e-3),
 )
 
 
@@ -134,7 +136,7 @@ def run(
             repeats=plan.kernel_repeats,
         )
     if "accuracy" in sections:
-        from viscoadh_ros.bench.accuracy import accuracy_grid, preset_table, reference_forces
+        from viscoadh_ros.bench.accuracy import accuracy_grid, preset_table, reference_forces, tolerance_table
         from viscoadh_ros.core.presets import PRESET_NAMES
 
         progress("accuracy: reference runs")
@@ -151,6 +153,13 @@ def run(
         results["presets"] = preset_table(
             references=references,
             presets=PRESET_NAMES,
+            rows=plan.preset_rows,
+            repeats=plan.accuracy_repeats,
+        )
+        progress("accuracy: tolerance mode")
+        results["tolerance"] = tolerance_table(
+            references=references,
+            tolerances=plan.accuracy_tolerances,
             rows=plan.preset_rows,
             repeats=plan.accuracy_repeats,
         )
