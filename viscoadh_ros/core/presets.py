@@ -42,6 +42,12 @@ Knobs:
 - growth_factor: the domain grows by this factor when the contact needs more room.
 - idle_tolerance: out of contact, memory below this fraction of the domain length counts
   as relaxed: the contact is idle, its memory is dropped and a step costs nothing.
+
+Tolerance mode (`numerics.tolerance` > 0, `numerics_for_tolerance`): the element count is
+the first of ELEMENT_LADDER whose error predicted by ERROR_MODEL for the scene's regime
+(`regime_of`: elastic, glassy over `numerics.time_scale`, one Kelvin element, K >= 2) is at
+most the tolerance, with `fast`'s step control; what that guarantees and where it was checked
+is in docs/configuration.md ("Choosing numerics by tolerance").
 """
 
 from __future__ import annotations
