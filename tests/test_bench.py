@@ -26,7 +26,6 @@ TINY = dataclasses.replace(
     accuracy_rows=(51,),
     reference_elements=32,
     reference_rows=101,
-    preset_rows=51,
     gripper_pads=(1,),
     gripper_seconds=0.01,
     accuracy_tolerances=(1e-2,),

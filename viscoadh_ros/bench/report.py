@@ -255,7 +255,9 @@ def render_markdown(results: dict[str, Any], figure: Path | None, notes: str | N
         lines += [
             "## Fidelity presets",
             "",
-            "`numerics.preset` in the scene; each preset's own element count and steps.",
+            "`numerics.preset` in the scene; each preset's own element count and steps, on the",
+            "reference run's history rows (a pull-off sampled by coarser rows than the reference's",
+            "differs from it by the sampling, which no numerics setting refines).",
             "",
         ]
         rows = [

@@ -38,7 +38,6 @@ class Plan:
     accuracy_repeats: int
     reference_elements: int
     reference_rows: int
-    preset_rows: int
     node_contacts: int
     node_duration_s: float
     replay_seconds: float
@@ -62,7 +61,6 @@ FULL = Plan(
     accuracy_repeats=2,
     reference_elements=1024,
     reference_rows=4001,
-    preset_rows=1001,
     node_contacts=4,
     node_duration_s=30.0,
     replay_seconds=60.0,
@@ -81,7 +79,6 @@ QUICK = Plan(
     accuracy_repeats=1,
     reference_elements=512,
     reference_rows=2001,
-    preset_rows=1001,
     node_contacts=4,
     node_duration_s=5.0,
     replay_seconds=10.0,
@@ -153,14 +150,14 @@ def run(
         results["presets"] = preset_table(
             references=references,
             presets=PRESET_NAMES,
-            rows=plan.preset_rows,
+            rows=plan.reference_rows,
             repeats=plan.accuracy_repeats,
         )
         progress("accuracy: tolerance mode")
         results["tolerance"] = tolerance_table(
             references=references,
             tolerances=plan.accuracy_tolerances,
-            rows=plan.preset_rows,
+            rows=plan.reference_rows,
             repeats=plan.accuracy_repeats,
         )
     if "node" in sections:
