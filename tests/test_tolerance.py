@@ -125,6 +125,7 @@ def test_the_regime_is_recognised_from_the_material_and_the_time_scale() -> None
         ("cone", 1e-2),
         ("power law n=1.5", 3e-3),
         ("fast retraction", 5e-3),
+        ("relaxed deep", 1e-2),
     ],
 )
 def test_the_resolved_numerics_meet_the_tolerance_against_the_independent_reference(
