@@ -82,7 +82,7 @@ def accuracy_figure(results: dict[str, Any], path: Path) -> None:
     floor = 1e-9
     case_names = sorted({point["case"] for point in results["accuracy"]})
     fig, axes = plt.subplots(
-        1, len(case_names), figsize=(5.2 * len(case_names), 4.6), squeeze=False, sharey=True
+        1, len(case_names), figsize=(5.4 * len(case_names), 5.2), squeeze=False, sharey=True
     )
     for axis, name in zip(axes[0], case_names, strict=True):
         points = [p for p in results["accuracy"] if p["case"] == name]
@@ -123,29 +123,33 @@ def accuracy_figure(results: dict[str, Any], path: Path) -> None:
             )
             for point in group:
                 text = point["preset"].replace("tolerance ", "tol ") + f" ({point['elements']})"
+                # presets labelled above-left, tolerances below-right: they sit close together
                 axis.annotate(
                     text,
                     (point["us_per_step"], max(point["rel_error"], floor)),
                     textcoords="offset points",
-                    xytext=(6, -10 if marker == "D" else 5),
+                    xytext=(7, -11) if marker == "D" else (-7, 7),
+                    ha="left" if marker == "D" else "right",
                     fontsize=8,
-                    color=color,
+                    color="darkgreen" if marker == "D" else "saddlebrown",
                 )
         for point in tolerance:
             axis.axhline(point["tolerance"], color="tab:green", linestyle=":", linewidth=0.8, alpha=0.6)
         axis.set_xscale("log")
         axis.set_yscale("log")
+        axis.margins(x=0.2)  # room for the labels of the cheapest and dearest points
         axis.set_xlabel("cost per history row (us)")
         axis.set_title(name.replace("_", " "))
         axis.grid(True, which="both", alpha=0.25)
     axes[0][0].set_ylabel("relative error of the pull-off force")
-    axes[0][0].legend(fontsize=8, loc="lower left")
+    handles, labels = axes[0][0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="lower center", ncol=len(labels), fontsize=9, frameon=False)
     fig.suptitle(
-        "Error against cost: presets (label: elements) and numerics.tolerance "
-        "(dotted: the tolerance asked; it bounds the force error relative to the pull-off force)",
+        "Error against cost: presets and numerics.tolerance, labelled with their element counts "
+        "(dotted: the tolerance asked, a bound on the force error relative to the pull-off force)",
         fontsize=10,
     )
-    fig.tight_layout()
+    fig.tight_layout(rect=(0.0, 0.06, 1.0, 1.0))
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=120)
     plt.close(fig)
