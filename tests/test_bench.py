@@ -26,9 +26,9 @@ TINY = dataclasses.replace(
     accuracy_rows=(51,),
     reference_elements=32,
     reference_rows=101,
-    preset_rows=51,
     gripper_pads=(1,),
     gripper_seconds=0.01,
+    accuracy_tolerances=(1e-2,),
 )
 
 
@@ -137,12 +137,15 @@ def test_quick_cli_writes_json_report_and_figure(
     assert [(r["elements"], r["kelvin"]) for r in results["kernel"]] == [(32, 0), (32, 1)]
     assert {r["case"] for r in results["accuracy"]} == {c.name for c in accuracy.cases()}
     assert {r["preset"] for r in results["presets"]} == {"fast", "balanced", "accurate"}
-    for row in results["accuracy"] + results["presets"]:
+    assert [(r["preset"], r["tolerance"]) for r in results["tolerance"]] == [("tolerance 0.01", 1e-2)] * 3
+    viscous = {r["case"]: r["elements"] for r in results["tolerance"]}
+    assert viscous["rate_dependent"] > viscous["jkr_pull_off"], "the elastic case resolves to fewer elements"
+    for row in results["accuracy"] + results["presets"] + results["tolerance"]:
         assert set(row) >= {"preset", "elements", "time_step", "case", "rel_error", "us_per_step"}
         assert_finite_numbers(row, f"{row['case']} {row['preset']}")
         assert row["rel_error"] >= 0.0
     text = output.read_text()
-    for heading in ("## Kernel", "## Accuracy", "## Fidelity presets", "## Stability"):
+    for heading in ("## Kernel", "## Accuracy", "## Fidelity presets", "## Tolerance mode", "## Stability"):
         assert heading in text, f"{heading} missing from the report"
     assert "](out/accuracy_pareto.png)" in text
     assert (tmp_path / "out" / "accuracy_pareto.png").stat().st_size > 0

@@ -10,6 +10,8 @@ Cases (all a sphere, displacement control, a piecewise-linear approach/retract c
   exists; the reference is a converged run (finest elements and steps, measured in the same run).
 
 The error of a run is `|F_min - F_ref| / |F_ref|`; its cost is the wall time per history row, us.
+The presets (`preset_table`) and the tolerance mode (`tolerance_table`: `numerics.tolerance`
+picks the element count for the scene) are measured on the same cases, for the same axes.
 """
 
 from __future__ import annotations
@@ -26,7 +28,7 @@ from viscoadh_ros.bench.timing import median_seconds
 from viscoadh_ros.core import reference
 from viscoadh_ros.core.config import ContactConfig, SceneConfig
 from viscoadh_ros.core.history import simulate_history
-from viscoadh_ros.core.presets import preset
+from viscoadh_ros.core.presets import preset, resolve_numerics
 from viscoadh_ros.core.rheology import CreepElement
 
 # A soft silicone-like body on a millimetre sphere: moduli and work of adhesion of the order of
@@ -194,6 +196,24 @@ def preset_table(
                 case, {"preset": name}, rows, reference_force=references[case.name], repeats=repeats
             )
             results.append(_row(case, name, preset(name).elements, rows, error, cost))
+    return results
+
+
+def tolerance_table(
+    *, references: dict[str, float], tolerances: Sequence[float], rows: int, repeats: int
+) -> list[dict[str, Any]]:
+    """Every case with `numerics.tolerance` set (balanced otherwise, no time scale given):
+    the element count the tolerance mode resolves for the case's scene, its error and cost."""
+    results = []
+    for case in cases():
+        for tolerance in tolerances:
+            numerics = {"tolerance": tolerance}
+            elements = resolve_numerics(contact_config(case, numerics).numerics).elements
+            error, cost = measure(
+                case, numerics, rows, reference_force=references[case.name], repeats=repeats
+            )
+            row = _row(case, f"tolerance {tolerance:g}", elements, rows, error, cost)
+            results.append(dict(row, tolerance=tolerance))
     return results
 
 

@@ -14,7 +14,7 @@ SECTIONS = ("kernel", "accuracy", "node", "replay", "batch", "gripper", "fit")
 #: merge replaces exactly these.
 SECTION_KEYS = {
     "kernel": ("kernel",),
-    "accuracy": ("accuracy", "presets"),
+    "accuracy": ("accuracy", "presets", "tolerance"),
     "node": ("node", "startup_s"),
     "replay": ("replay",),
     "batch": ("batch",),
@@ -39,7 +39,6 @@ class Plan:
     accuracy_repeats: int
     reference_elements: int
     reference_rows: int
-    preset_rows: int
     node_contacts: int
     node_duration_s: float
     replay_seconds: float
@@ -53,6 +52,7 @@ class Plan:
     fit_samples: int = 5000
     fit_starts: int = 4
     fit_kelvin_starts: int = 1
+    accuracy_tolerances: tuple[float, ...] = (1e-2, 1e-3, 1e-4)
 
 
 FULL = Plan(
@@ -65,7 +65,6 @@ FULL = Plan(
     accuracy_repeats=2,
     reference_elements=1024,
     reference_rows=4001,
-    preset_rows=1001,
     node_contacts=4,
     node_duration_s=30.0,
     replay_seconds=60.0,
@@ -84,7 +83,6 @@ QUICK = Plan(
     accuracy_repeats=1,
     reference_elements=512,
     reference_rows=2001,
-    preset_rows=1001,
     node_contacts=4,
     node_duration_s=5.0,
     replay_seconds=10.0,
@@ -97,6 +95,7 @@ QUICK = Plan(
     fit_samples=1000,
     fit_starts=2,
     fit_kelvin_starts=1,
+    accuracy_tolerances=(1e-2, 1e-3),
 )
 
 
@@ -141,7 +140,7 @@ def run(
             repeats=plan.kernel_repeats,
         )
     if "accuracy" in sections:
-        from viscoadh_ros.bench.accuracy import accuracy_grid, preset_table, reference_forces
+        from viscoadh_ros.bench.accuracy import accuracy_grid, preset_table, reference_forces, tolerance_table
         from viscoadh_ros.core.presets import PRESET_NAMES
 
         progress("accuracy: reference runs")
@@ -158,7 +157,14 @@ def run(
         results["presets"] = preset_table(
             references=references,
             presets=PRESET_NAMES,
-            rows=plan.preset_rows,
+            rows=plan.reference_rows,
+            repeats=plan.accuracy_repeats,
+        )
+        progress("accuracy: tolerance mode")
+        results["tolerance"] = tolerance_table(
+            references=references,
+            tolerances=plan.accuracy_tolerances,
+            rows=plan.reference_rows,
             repeats=plan.accuracy_repeats,
         )
     if "node" in sections:

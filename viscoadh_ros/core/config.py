@@ -41,7 +41,7 @@ import math
 import re
 import sys
 from collections.abc import Mapping
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 from typing import Any
 
@@ -49,7 +49,7 @@ import numpy as np
 import yaml
 
 from viscoadh_ros.core.errors import ConfigError, InputError
-from viscoadh_ros.core.presets import resolve_numerics
+from viscoadh_ros.core.presets import TOLERANCE_RANGE, SceneHint, resolve_numerics
 from viscoadh_ros.core.profiles import make_profile
 from viscoadh_ros.core.rheology import CreepElement, prony_to_creep
 
@@ -121,7 +121,16 @@ class NumericsConfig:
     preset: ``fast | balanced | accurate``. model: ``auto | closed_form | time_stepped``.
     elements: MDR elements (int, 0 or >= 4). domain_radius: initial domain length, m.
     max_substep: longest internal substep, s. force_tolerance: relative force tolerance
-    of force control (< 1).
+    of force control (< 1). tolerance: the force error the numerics must meet, relative to
+    the pull-off force (0 = the preset's numerics, else in (0, 1)); the element count and
+    step control are then the cheapest the convergence study says meet it for the scene
+    (``presets.numerics_for_tolerance``). time_scale: the shortest time over which the
+    scene's loading changes, s (0 = unknown: the worst case of every regime); with it the
+    tolerance mode recognises a relaxed or glassy body.
+
+    ``scene`` is not a parameter: `ContactConfig` attaches what the tolerance mode reads of
+    the contact's material and indenter (``presets.SceneHint``); it takes no part in
+    equality, the schema or ``to_parameters``.
     """
 
     preset: str = "balanced"
@@ -130,6 +139,9 @@ class NumericsConfig:
     domain_radius: float = 0.0
     max_substep: float = 0.0
     force_tolerance: float = 0.0
+    tolerance: float = 0.0
+    time_scale: float = 0.0
+    scene: SceneHint | None = field(default=None, compare=False, repr=False, metadata={"schema": False})
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -141,6 +153,13 @@ class ContactConfig:
     material: MaterialConfig
     adhesion: AdhesionConfig = AdhesionConfig()
     numerics: NumericsConfig = NumericsConfig()
+
+    def __post_init__(self) -> None:
+        # The tolerance mode resolves the numerics for this contact's material and indenter:
+        # hand them to `resolve_numerics` with the numerics (a `replace` re-runs this).
+        hint = SceneHint.of(self.indenter, self.material)
+        if self.numerics.scene != hint:
+            object.__setattr__(self, "numerics", replace(self.numerics, scene=hint))
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -182,8 +201,13 @@ _SECTIONS = {
 _KIND_OF_TYPE = {"float": "float", "int": "int", "str": "str", "bool": "bool", "tuple[float, ...]": "floats"}
 
 
+def _schema_fields(cls: type) -> list[Any]:
+    """The fields of a section that are parameters (not the numerics' attached scene)."""
+    return [f for f in fields(cls) if f.metadata.get("schema", True)]
+
+
 def _kinds(cls: type) -> dict[str, str]:
-    return {f.name: _KIND_OF_TYPE[str(f.type)] for f in fields(cls)}
+    return {f.name: _KIND_OF_TYPE[str(f.type)] for f in _schema_fields(cls)}
 
 
 #: contact-level keys, relative to ``<id>.``: "indenter.shape" -> "str", ...
@@ -230,14 +254,19 @@ _ID_PATTERN = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
 _NODE_ROOTS = {key.split(".")[0] for key in NODE_KEYS} | {"contacts"}
 
 
+#: Keys whose type errors also state the allowed values (the rest state them on range errors).
+_ALLOWED = {"numerics.tolerance": TOLERANCE_RANGE}
+
+
 def _coerce(key: str, kind: str, value: Any) -> Any:
     """``value`` converted to the schema kind, or ConfigError naming ``key``."""
     if kind == "float":
+        allowed = next((f", {text}" for leaf, text in _ALLOWED.items() if key.endswith(f".{leaf}")), "")
         if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
-            raise ConfigError(f"{key} must be a number (got {value!r})")
+            raise ConfigError(f"{key} must be a number{allowed} (got {value!r})")
         number = float(value)
         if not math.isfinite(number):
-            raise ConfigError(f"{key} must be finite (got {value!r})")
+            raise ConfigError(f"{key} must be finite{allowed} (got {value!r})")
         return number
     if kind == "int":
         if isinstance(value, (float, np.floating)) and float(value).is_integer():
@@ -375,7 +404,7 @@ def _build_contact(contact_id: str, given: dict[str, Any]) -> ContactConfig:
         if adhesion.interaction_range <= 0.0:
             raise InputError(f"adhesion.interaction_range must be > 0 (got {adhesion.interaction_range!r})")
         numerics = NumericsConfig(**section("numerics"))
-        resolve_numerics(numerics)
+        resolve_numerics(replace(numerics, scene=SceneHint.of(indenter_config, element)))
     except (InputError, ConfigError) as error:
         raise _prefixed(contact_id, error) from None
     material_config = MaterialConfig(
@@ -522,7 +551,7 @@ class SceneConfig:
             for name in (_PRONY_KEYS if material.given_as_prony else _KELVIN_KEYS) + ("poisson_ratio",):
                 flat[f"{prefix}material.{name}"] = _plain(getattr(material, name))
             for section in ("adhesion", "numerics"):
-                for item in fields(_SECTIONS[section]):
+                for item in _schema_fields(_SECTIONS[section]):
                     flat[f"{prefix}{section}.{item.name}"] = _plain(
                         getattr(getattr(contact, section), item.name)
                     )

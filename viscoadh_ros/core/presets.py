@@ -42,12 +42,20 @@ Knobs:
 - growth_factor: the domain grows by this factor when the contact needs more room.
 - idle_tolerance: out of contact, memory below this fraction of the domain length counts
   as relaxed: the contact is idle, its memory is dropped and a step costs nothing.
+
+Tolerance mode (`numerics.tolerance` > 0, `numerics_for_tolerance`): the element count is
+the first of ELEMENT_LADDER whose error predicted by ERROR_MODEL for the scene's regime
+(`regime_of`: elastic, glassy over `numerics.time_scale`, one Kelvin element, K >= 2) is at
+most the tolerance, with `fast`'s step control; what that guarantees and where it was checked
+is in docs/configuration.md ("Choosing numerics by tolerance").
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
 from typing import Any
+
+import numpy as np
 
 from .errors import ConfigError
 
@@ -85,9 +93,27 @@ def preset(name: str) -> ResolvedNumerics:
     return _PRESETS[name]
 
 
+def _number(numerics: Any, key: str) -> float:
+    """numerics.<key> as a finite float >= 0 (0 when absent), or ConfigError naming it."""
+    value = getattr(numerics, key, 0.0)
+    if isinstance(value, bool) or isinstance(value, str):
+        raise ConfigError(f"numerics.{key} must be a number (got {value!r})")
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        raise ConfigError(f"numerics.{key} must be a number (got {value!r})") from None
+    if not number >= 0.0 or number == float("inf"):
+        raise ConfigError(f"numerics.{key} must be finite and >= 0 (got {value!r})")
+    return number
+
+
 def resolve_numerics(numerics: Any) -> ResolvedNumerics:
     """Resolve a `NumericsConfig` (fields preset, model, elements, domain_radius,
-    max_substep, force_tolerance; 0 = from the preset) into concrete numbers."""
+    max_substep, force_tolerance, tolerance, time_scale; 0 = from the preset) into concrete
+    numbers. With ``tolerance`` > 0 the element count and step control come from
+    `numerics_for_tolerance` for the scene the config carries (``numerics.scene``, a
+    `SceneHint` that `ContactConfig` attaches; none: the worst case of every regime);
+    an explicit ``elements`` still wins."""
     base = preset(getattr(numerics, "preset", "balanced"))
     model = getattr(numerics, "model", "auto")
     if model not in MODEL_NAMES:
@@ -99,17 +125,174 @@ def resolve_numerics(numerics: Any) -> ResolvedNumerics:
     if elements:
         if elements < 4:
             raise ConfigError(f"numerics.elements must be >= 4 or 0 for the preset (got {elements!r})")
-        overrides["elements"] = elements
     for key in ("domain_radius", "max_substep", "force_tolerance"):
-        value = getattr(numerics, key, 0.0)
-        try:
-            number = float(value)
-        except (TypeError, ValueError):
-            raise ConfigError(f"numerics.{key} must be a number (got {value!r})") from None
-        if not number >= 0.0 or number == float("inf"):
-            raise ConfigError(f"numerics.{key} must be finite and >= 0 (got {value!r})")
+        number = _number(numerics, key)
         if number > 0.0:
             overrides[key] = number
     if overrides.get("force_tolerance", 0.0) >= 1.0:
         raise ConfigError(f"numerics.force_tolerance must be < 1 (got {overrides['force_tolerance']!r})")
+    tolerance = check_tolerance(getattr(numerics, "tolerance", 0.0))
+    time_scale = _number(numerics, "time_scale")
+    if tolerance > 0.0:
+        hint = getattr(numerics, "scene", None)
+        chosen = numerics_for_tolerance(tolerance, hint, time_scale=time_scale)
+        base = replace(
+            base,
+            elements=chosen.elements,
+            fine_factor=chosen.fine_factor,
+            max_edge_cells=chosen.max_edge_cells,
+            force_tolerance=min(base.force_tolerance, chosen.force_tolerance),
+        )
+    if elements:
+        overrides["elements"] = elements
     return replace(base, **overrides)
+
+
+# --- tolerance mode --------------------------------------------------------------------------
+
+#: The tightest and loosest tolerance accepted: (0, 1) open, 0 = use the preset.
+TOLERANCE_RANGE = "0 (use the preset) or in (0, 1)"
+
+
+def check_tolerance(value: Any) -> float:
+    """numerics.tolerance as a float: 0, or in the open interval (0, 1); ConfigError naming
+    the range otherwise (text, bool, NaN, infinity, negative, >= 1)."""
+    if isinstance(value, (bool, str)) or value is None:
+        raise ConfigError(f"numerics.tolerance must be a number, {TOLERANCE_RANGE} (got {value!r})")
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        raise ConfigError(f"numerics.tolerance must be a number, {TOLERANCE_RANGE} (got {value!r})") from None
+    if number != 0.0 and not 0.0 < number < 1.0:
+        raise ConfigError(f"numerics.tolerance must be {TOLERANCE_RANGE} (got {value!r})")
+    return number
+
+
+@dataclass(frozen=True)
+class SceneHint:
+    """What the tolerance mode reads of a contact's scene (`ContactConfig` attaches it to its
+    numerics, so `resolve_numerics` sees it): the relaxation times of the in-contact Kelvin
+    chain, s (empty: elastic), and the indenter shape."""
+
+    relaxation_times: tuple[float, ...]
+    shape: str
+
+    @classmethod
+    def of(cls, indenter: Any, material: Any) -> SceneHint:
+        """From an `IndenterConfig` and a `MaterialConfig` (core/config.py)."""
+        return cls(
+            relaxation_times=relaxation_times(
+                material.glass_shear_modulus, material.kelvin_shear_moduli, material.kelvin_viscosities
+            ),
+            shape=str(indenter.shape),
+        )
+
+
+def relaxation_times(glass: float, moduli: Any, viscosities: Any) -> tuple[float, ...]:
+    """Relaxation times of the Kelvin chain held at a fixed displacement, s, ascending: the
+    inverse eigenvalues of ``D^-1 (G0 11^T + diag(G_k))`` (one element: ``eta1 / (G0 + G1)``)."""
+    g = np.asarray(moduli, dtype=np.float64)
+    eta = np.asarray(viscosities, dtype=np.float64)
+    if g.size == 0:
+        return ()
+    root = np.sqrt(eta)
+    stiffness = glass * np.ones((g.size, g.size)) + np.diag(g)
+    rates = np.linalg.eigvalsh(stiffness / np.outer(root, root))
+    return tuple(sorted(float(1.0 / rate) for rate in rates))
+
+
+@dataclass(frozen=True)
+class ToleranceChoice:
+    """What `numerics_for_tolerance` picked: the regime it recognised, the element count and
+    step control, the error the model predicts for them (relative to the pull-off force) and
+    the force-control tolerance."""
+
+    regime: str
+    elements: int
+    fine_factor: int
+    max_edge_cells: float
+    predicted_error: float
+    force_tolerance: float
+
+
+#: Step control of the tolerance mode: `fast`'s (fine_factor 16, max_edge_cells 2). In the
+#: convergence study it gives the same force errors as `balanced`'s (32, 1) at every element
+#: count from 32 to 640 in every regime (within 11 %, the reference's noise) at about 2/3 of
+#: the cost, so the element count is the only knob the tolerance has to turn.
+STEP_CONTROL = (16, 2.0)
+#: Element counts the tolerance mode chooses from, cheapest first (cost ~ linear in them).
+ELEMENT_LADDER = (
+    16, 24, 32, 40, 48, 64, 80, 96, 128, 160, 192, 256, 320, 384, 512, 640, 768, 1024,
+    1280, 1536, 2048, 2560, 3072, 4096, 5120, 6144, 8192,
+)  # fmt: skip
+#: Observed error model per regime: the largest force error of a press-and-pull history
+#: (pull-off and every row of both branches) relative to the pull-off force is at most
+#: ``max(C N^-p)`` over the terms; envelopes of the measured errors with a 20 % margin.
+#: - elastic, glassy: against the closed form (exact for an elastic body), sphere 5 and
+#:   300 d_c deep, N = 16..2048: 0.36-0.53 N^-2.
+#: - viscoelastic, one Kelvin element (relaxed, partly relaxed, slow and fast retraction,
+#:   sphere, cone, power law, 5-300 d_c): against the independent reference
+#:   (benchmarks/convergence_reference.json), N = 32..640: at most 295 N^-2 (the deep case)
+#:   until the reference's own uncertainty (~1e-3 of the pull-off force).
+#: - K >= 2 (the Prony K = 3 case): 6.2-9.0 N^-1.3.
+#: Made by `python benchmarks/tolerance_model.py` (prints the measured constants).
+ERROR_MODEL: dict[str, tuple[tuple[float, float], ...]] = {
+    "elastic": ((0.65, 2.0),),
+    "glassy": ((0.65, 2.0),),
+    "viscoelastic": ((350.0, 2.0),),
+    "viscoelastic, K >= 2": ((350.0, 2.0), (11.0, 1.3)),
+}
+#: A body counts as glassy over the time scale T when its shortest relaxation time is at least
+#: T / (GLASSY_FRACTION * tolerance): its memory then moves less than a tenth of the
+#: tolerance over T. Anything else viscoelastic takes the viscoelastic model (relaxed bodies
+#: included: the study shows no smaller error for them).
+GLASSY_FRACTION = 0.1
+
+
+def regime_of(hint: SceneHint | None, *, tolerance: float, time_scale: float = 0.0) -> str:
+    """The error-model regime of a scene: "elastic" (K = 0), "glassy" (every relaxation time
+    long against `time_scale`, see GLASSY_FRACTION), "viscoelastic" (one Kelvin element) or
+    "viscoelastic, K >= 2"; the worst case, "viscoelastic, K >= 2", when nothing is known."""
+    if hint is None:
+        return "viscoelastic, K >= 2"
+    times = hint.relaxation_times
+    if not times:
+        return "elastic"
+    if time_scale > 0.0 and min(times) * GLASSY_FRACTION * tolerance >= time_scale:
+        return "glassy"
+    return "viscoelastic" if len(times) == 1 else "viscoelastic, K >= 2"
+
+
+def predicted_error(regime: str, elements: int) -> float:
+    """The error model's bound on the force error at `elements` elements (see ERROR_MODEL)."""
+    return max(c * elements ** (-p) for c, p in ERROR_MODEL[regime])
+
+
+def numerics_for_tolerance(
+    tolerance: float, hint: SceneHint | None = None, *, time_scale: float = 0.0
+) -> ToleranceChoice:
+    """The cheapest element count of ELEMENT_LADDER (with STEP_CONTROL) whose predicted force
+    error in the scene's regime is at most `tolerance` (relative to the pull-off force).
+    A tighter tolerance never gives fewer elements. ConfigError when even the last rung
+    cannot meet it."""
+    tolerance = check_tolerance(tolerance)
+    if tolerance == 0.0:
+        raise ConfigError("numerics.tolerance must be > 0 to choose numerics by it")
+    regime = regime_of(hint, tolerance=tolerance, time_scale=time_scale)
+    for elements in ELEMENT_LADDER:
+        error = predicted_error(regime, elements)
+        if error <= tolerance:
+            fine_factor, max_edge_cells = STEP_CONTROL
+            return ToleranceChoice(
+                regime=regime,
+                elements=elements,
+                fine_factor=fine_factor,
+                max_edge_cells=max_edge_cells,
+                predicted_error=error,
+                force_tolerance=0.01 * tolerance,
+            )
+    finest = predicted_error(regime, ELEMENT_LADDER[-1])
+    raise ConfigError(
+        f"numerics.tolerance {tolerance:g} is tighter than this scene can be guaranteed ({regime} "
+        f"body: {ELEMENT_LADDER[-1]} elements give {finest:.1g}); loosen it or set numerics.elements"
+    )

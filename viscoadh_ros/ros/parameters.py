@@ -128,6 +128,18 @@ _CONTACT_SPECS: dict[str, _Spec] = {
         low=0.0,
         high=1.0,
     ),
+    "numerics.tolerance": _Spec(
+        "Force error the numerics must meet, relative to the pull-off force (0 = the preset's "
+        "numerics, else in (0, 1)): the cheapest element count the convergence study says meets it.",
+        low=0.0,
+        high=1.0,
+    ),
+    "numerics.time_scale": _Spec(
+        "Shortest time over which the loading changes, s (0 = unknown); lets numerics.tolerance "
+        "recognise a glassy body.",
+        low=0.0,
+        high=_INF,
+    ),
 }
 
 _NODE_SPECS: dict[str, _Spec] = {
