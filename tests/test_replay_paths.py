@@ -127,3 +127,27 @@ def test_contact_whose_topics_are_absent_is_an_error(
     assert code == 2 and len(err.splitlines()) == 1, err
     assert "cone/indentation" in err and "/finger/indentation" in err, err
     assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        pytest.param(["replay", "{bag}", "-o", "{tmp}/missing/out.mcap"], id="replay-output"),
+        pytest.param(["replay", "{bag}", "-o", "{tmp}/out.mcap", "--json", "{tmp}/missing/s.json"], id="replay-json"),
+        pytest.param(["replay", "{bag}", "{bag}", "-o", "{tmp}/missing/deeper/out"], id="replay-batch-folder"),
+        pytest.param(["fit", "{bag}", "-o", "{tmp}/missing/fit.yaml"], id="fit-output"),
+    ],
+)
+def test_an_output_in_a_missing_folder_is_refused_before_any_work(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], argv: list[str]
+) -> None:
+    """The file rule of every verb (docs/cli.md): one line, exit 2, nothing written, no folder
+    created (replay crashed with a traceback after the whole run, leaving OUT written but not
+    its --json; fit created the folder)."""
+    bag = _node_log(tmp_path / "log.mcap")
+    before = sorted(p.relative_to(tmp_path) for p in tmp_path.rglob("*"))
+    code = main([a.format(bag=bag, tmp=tmp_path) for a in argv])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2, err
+    assert len(err) == 1 and "does not exist" in err[0], err
+    assert sorted(p.relative_to(tmp_path) for p in tmp_path.rglob("*")) == before, "nothing written"

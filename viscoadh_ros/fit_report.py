@@ -159,7 +159,6 @@ def write_report(
         family="monospace",
     )
     fig.suptitle(title or "fit report")
-    figure_path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(figure_path, dpi=110)
     plt.close(fig)
     table_path.write_text(text, encoding="utf-8")

@@ -770,6 +770,7 @@ def fit_bag(path: str, options: dict[str, Any]) -> FileFit:
     from viscoadh_ros.core.config import SceneConfig
     from viscoadh_ros.experiment import choose_contact, load_experiment
     from viscoadh_ros.io.bag import Bag
+    from viscoadh_ros.io.csv_io import check_output_folder
     from viscoadh_ros.io.mcap_log import plain
 
     unknown = sorted(set(options) - set(FILE_OPTIONS))
@@ -817,7 +818,7 @@ def fit_bag(path: str, options: dict[str, Any]) -> FileFit:
     written: list[str] = []
     if opts["output"] is not None:
         output = Path(opts["output"])
-        output.parent.mkdir(parents=True, exist_ok=True)
+        check_output_folder(output)
         output.write_text(yaml.safe_dump(plain(fitted.to_dict()), sort_keys=False), encoding="utf-8")
         written.append(str(output))
         if opts["report"]:

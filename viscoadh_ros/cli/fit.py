@@ -18,6 +18,7 @@ from viscoadh_ros.cli._paths import refuse_overwrite
 from viscoadh_ros.cli.replay import add_input_arguments, batch_bags, batch_main, input_options
 from viscoadh_ros.core.errors import InputError
 from viscoadh_ros.fitting import BOUNDS_FACTOR, SEGMENTS, fit_bag, unit_of
+from viscoadh_ros.io.csv_io import check_output_folder
 
 
 def _kelvin(text: str) -> int:
@@ -78,6 +79,7 @@ def main(args: argparse.Namespace) -> int:
 
     outputs = [args.output] if args.no_report else [args.output, *report_paths(args.output)]
     refuse_overwrite([args.bag, args.scene], [("--output", path) for path in outputs])
+    check_output_folder(args.output)
     options = {
         "scene": args.scene,
         "contact": args.contact,

@@ -29,6 +29,7 @@ from viscoadh_ros.experiment import (
     run_model,
 )
 from viscoadh_ros.io.bag import Bag
+from viscoadh_ros.io.csv_io import check_output_folder
 
 if TYPE_CHECKING:
     from viscoadh_ros.core.config import SceneConfig
@@ -113,7 +114,12 @@ def batch_main(
         [*bags, options.get("scene")],
         [("--summary", summary), ("--json", json_path), *(("--output", o) for o in outputs)],
     )
-    folder.mkdir(parents=True, exist_ok=True)
+    # The -o folder itself may be new (one file per bag goes into it); the folders it and the
+    # summary go into must exist, as for every other output (docs/cli.md).
+    for path in (folder, summary, json_path):
+        if path is not None:
+            check_output_folder(path)
+    folder.mkdir(exist_ok=True)
     per_bag = [{**options, "output": str(o)} for o in outputs]
     rows = batch.run_batch(task, bags, per_bag, workers=args.workers, scheduler=args.scheduler)
     batch.write_summary(summary, rows)
@@ -189,6 +195,9 @@ def main(args: argparse.Namespace) -> int:
     if args.output.suffix != ".mcap":
         raise InputError(f"--output must be an .mcap file (got {str(args.output)!r})")
     refuse_overwrite([args.bag, args.scene], [("--output", args.output), ("--json", args.json)])
+    for path in (args.output, args.json):
+        if path is not None:
+            check_output_folder(path)
     result, experiment = replay_one(args, progress=True)
     skipped = experiment.rejected_index.size
     print(
