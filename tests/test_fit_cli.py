@@ -39,6 +39,7 @@ def _fit_args(bag: Path, start: Path, out: Path, *extra: str) -> list[str]:
 def test_fit_writes_scene_and_report_with_intervals(bag: Path, tmp_path: Path, capsys) -> None:
     start = write_scene(tmp_path / "start.yaml", START)
     out = tmp_path / "results" / "fitted.yaml"
+    out.parent.mkdir()  # a verb never creates folders (docs/cli.md)
     assert main(_fit_args(bag, start, out)) == 0
     printed = capsys.readouterr().out
     fitted = parameters_of(SceneConfig.from_yaml(out).contacts[0])

@@ -133,8 +133,12 @@ def test_contact_whose_topics_are_absent_is_an_error(
     "argv",
     [
         pytest.param(["replay", "{bag}", "-o", "{tmp}/missing/out.mcap"], id="replay-output"),
-        pytest.param(["replay", "{bag}", "-o", "{tmp}/out.mcap", "--json", "{tmp}/missing/s.json"], id="replay-json"),
-        pytest.param(["replay", "{bag}", "{bag}", "-o", "{tmp}/missing/deeper/out"], id="replay-batch-folder"),
+        pytest.param(
+            ["replay", "{bag}", "-o", "{tmp}/out.mcap", "--json", "{tmp}/missing/s.json"], id="replay-json"
+        ),
+        pytest.param(
+            ["replay", "{bag}", "{bag}", "-o", "{tmp}/missing/deeper/out"], id="replay-batch-folder"
+        ),
         pytest.param(["fit", "{bag}", "-o", "{tmp}/missing/fit.yaml"], id="fit-output"),
     ],
 )

@@ -116,7 +116,7 @@ def batch_main(
     )
     # The -o folder itself may be new (one file per bag goes into it); the folders it and the
     # summary go into must exist, as for every other output (docs/cli.md).
-    for path in (folder, summary, json_path):
+    for path in (folder, args.summary, json_path):
         if path is not None:
             check_output_folder(path)
     folder.mkdir(exist_ok=True)
