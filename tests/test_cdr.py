@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
@@ -119,3 +120,27 @@ def test_experiment_reads_mixed_frames_through_rclpy(tmp_path: Any) -> None:
     np.testing.assert_array_equal(
         experiment.measured_ns, [10e9, 11e9, 12e9, 13e9 + 5], err_msg="header stamps, else log time"
     )
+
+
+@pytest.mark.parametrize("frame_id", ["", "a", "abc", "abcd", "hand_frame_01"])
+def test_parse_command_reads_what_rclpy_serialises(frame_id: str) -> None:
+    """The live path's raw command reader gives rclpy's fields for every frame_id padding."""
+    from rclpy.serialization import serialize_message
+    from viscoadh_msgs.msg import IndentationCommand
+
+    msg = IndentationCommand(mode=IndentationCommand.FORCE, depth=-1.5e-4, force=float("nan"))
+    msg.header.stamp.sec, msg.header.stamp.nanosec = 1_700_000_000, 999_999_999
+    msg.header.frame_id = frame_id
+    sec, nanosec, mode, depth, force = cdr.parse_command(serialize_message(msg))
+    assert (sec, nanosec, mode, depth) == (1_700_000_000, 999_999_999, IndentationCommand.FORCE, -1.5e-4)
+    assert math.isnan(force)
+
+
+def test_parse_command_leaves_other_layouts_to_rclpy() -> None:
+    from rclpy.serialization import serialize_message
+    from viscoadh_msgs.msg import IndentationCommand
+
+    payload = serialize_message(IndentationCommand(depth=1.0))
+    assert cdr.parse_command(b"\x00\x00\x00\x00" + payload[4:]) is None, "big endian"
+    assert cdr.parse_command(payload[:-1]) is None, "cut"
+    assert cdr.parse_command(payload + b"\x00" * 8) is None, "longer than the layout"

@@ -78,12 +78,17 @@ def profile_live(
                     messages.append(msg)
                 feed = [(node.hand.on_command, m) for m in messages]
             else:
+                # Serialised, as the live thread takes them (raw), when the node takes them so.
+                from rclpy.serialization import serialize_message
+
                 feed = []
                 for tick in range(ticks):
                     for contact_id in ids:
                         msg = IndentationCommand(mode=IndentationCommand.DEPTH, depth=depth_at(tick * 1e-3))
                         msg.header.stamp = ns_to_stamp(t0 + tick * 1_000_000)
-                        feed.append((node.contacts[contact_id].on_command, msg))
+                        contact = node.contacts[contact_id]
+                        raw = getattr(contact, "on_raw_command", None)
+                        feed.append((raw, serialize_message(msg)) if raw else (contact.on_command, msg))
             recorder = node._recorder
             writer = recorder._thread if recorder is not None else None
             writer_cpu0 = _thread_cpu_s(writer) if writer is not None else 0.0

@@ -130,6 +130,29 @@ class Packer:
         return bytes(buffer)
 
 
+_COMMAND_HEAD = struct.Struct("<iII")  # stamp.sec, stamp.nanosec, frame_id length
+_COMMAND_VALUES = struct.Struct("<dd")  # depth, force
+
+
+def parse_command(payload: bytes) -> tuple[int, int, int, float, float] | None:
+    """``(stamp.sec, stamp.nanosec, mode, depth, force)`` of one serialised IndentationCommand
+    (a live path's raw take, ~1 us against ~15 us for rclpy's message object); None when it is
+    not little-endian CDR of that layout (the caller then falls back to rclpy)."""
+    if payload[:4] != _ENCAPSULATION or len(payload) < _HEADER + 12:
+        return None
+    sec, nanosec, frame = _COMMAND_HEAD.unpack_from(payload, _HEADER)
+    position = 12 + frame  # from the end of the encapsulation header
+    if frame < 1 or len(payload) < _HEADER + position + 1:
+        return None
+    mode = payload[_HEADER + position]
+    position += 1
+    position += -position % 8
+    if len(payload) != _HEADER + position + 16:
+        return None
+    depth, force = _COMMAND_VALUES.unpack_from(payload, _HEADER + position)
+    return sec, nanosec, mode, depth, force
+
+
 def decode(type_name: str, payloads: Sequence[bytes] | NDArray[np.uint8]) -> dict[str, NDArray] | None:
     """Every field of ``payloads`` (n CDR messages of ``type_name``, or an (n, L) uint8 array of
     them, see ``Bag.rows``) as arrays of shape (n,), plus ``stamp_ns`` (int64, ns) for stamped
