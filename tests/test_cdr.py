@@ -144,3 +144,29 @@ def test_parse_command_leaves_other_layouts_to_rclpy() -> None:
     assert cdr.parse_command(b"\x00\x00\x00\x00" + payload[4:]) is None, "big endian"
     assert cdr.parse_command(payload[:-1]) is None, "cut"
     assert cdr.parse_command(payload + b"\x00" * 8) is None, "longer than the layout"
+
+
+@pytest.mark.parametrize("count", [0, 1, 3, 16])
+@pytest.mark.parametrize("frame_id", ["", "ab", "hand"])
+def test_hand_state_payload_is_what_rclpy_serialises(count: int, frame_id: str) -> None:
+    from viscoadh_msgs.msg import HandState
+
+    rng = np.random.default_rng(count)
+    ids = [f"finger_{'x' * k}" for k in range(count)]
+    columns = {}
+    for name, dtype in cdr.HAND_STATE_ARRAYS:
+        if dtype == "?":
+            columns[name] = (rng.random(count) < 0.5).tolist()
+        elif dtype == "u1":
+            columns[name] = rng.integers(0, 4, size=count).tolist()
+        else:
+            columns[name] = (rng.normal(size=count) * 1e-3).tolist()
+    payload = cdr.pack_hand_state(1_234_567_890_123, frame_id, ids, columns, 7, 2)
+    msg = HandState(contact_ids=ids, commands_received=7, commands_rejected=2, **columns)
+    msg.header.stamp.sec, msg.header.stamp.nanosec = 1234, 567_890_123
+    msg.header.frame_id = frame_id
+    # Same fields (not the same bytes: rclpy leaves alignment padding uninitialised, and for
+    # empty arrays its buffer carries uninitialised bytes after the message).
+    back = deserialize_message(payload, HandState)
+    assert back == msg
+    assert list(back.contact_ids) == ids and list(back.force) == columns["force"]

@@ -45,13 +45,14 @@ from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy, qos_polic
 from rclpy.serialization import deserialize_message
 from rosgraph_msgs.msg import Clock
 from std_srvs.srv import Trigger
-from viscoadh_msgs.msg import ContactEvent, ContactState, IndentationCommand
+from viscoadh_msgs.msg import ContactEvent, ContactState, HandCommand, HandState, IndentationCommand
 from viscoadh_msgs.srv import PredictPullOff, SimulateHistory
 from visualization_msgs.msg import Marker
 
 from viscoadh_ros.core._kernels import warm_up
 from viscoadh_ros.core.config import ContactConfig, SceneConfig
 from viscoadh_ros.core.errors import ConfigError, InputError
+from viscoadh_ros.core.hand import ContactStepError, step_contacts
 from viscoadh_ros.core.history import predict_pull_off, simulate_history
 from viscoadh_ros.core.simulator import ContactSimulator, StepOutput
 from viscoadh_ros.io import cdr
@@ -302,9 +303,13 @@ class _Contact:
             state = self._state_locked(output, stamp_ns)
         self._publish(state, output, stamp_ns, now_ns)
 
-    def accepted_locked(self, epoch_ns: int, stamp_ns: int, now_ns: int, control: dict[str, float]) -> None:
-        """Book an accepted command stamped ``stamp_ns`` (on either command topic)."""
-        self.counters.commands_received += 1
+    def accepted_locked(
+        self, epoch_ns: int, stamp_ns: int, now_ns: int, control: dict[str, float], *, count: bool = True
+    ) -> None:
+        """Book an accepted command stamped ``stamp_ns``; ``count``: it came on
+        ``C/indentation`` (a hand command counts on the hand's counters instead)."""
+        if count:
+            self.counters.commands_received += 1
         self.epoch_ns = epoch_ns
         self.hold = control
         self.last_command_ns = stamp_ns
@@ -498,6 +503,187 @@ class _Contact:
             )
 
 
+class _Hand:
+    """The hand topics: ``hand/indentation`` (HandCommand: several contacts in one sample),
+    answered with one ``hand/state`` (HandState) and logged as one record each; a rejected hand
+    command changes no contact and publishes one ContactEvent on ``hand/events``.
+
+    The rules are those of ``C/indentation`` (docs/ros_interface.md), applied to every contact
+    of the sample before any is stepped: mode, one finite value per contact, known ids each
+    once, a stamp neither malformed, nor too far ahead, nor older than any listed contact's last
+    command (from either topic). The steps are one :func:`~viscoadh_ros.core.hand.step_contacts`
+    call, all or nothing. A contact's own ``C/state`` does not repeat what ``hand/state`` says;
+    its hold timer takes over when hand commands stop.
+    """
+
+    def __init__(self, node: ViscoadhNode) -> None:
+        self.node = node
+        self.commands_seen = 0
+        self.commands_received = 0
+        self.commands_rejected = 0
+        self.last_rejection = ""
+        self._order = list(node.contacts)
+        self.state_pub = node.create_publisher(HandState, "hand/state", _QOS_DEPTH)
+        self.events_pub = node.create_publisher(ContactEvent, "hand/events", EVENTS_QOS)
+        self.subscription = node.create_subscription(
+            HandCommand, "hand/indentation", self.on_command, COMMAND_QOS, callback_group=node.live_group
+        )
+        self.command_topic = self.subscription.topic_name
+        self.state_topic = self.state_pub.topic_name
+        self.events_topic = self.events_pub.topic_name
+
+    def take_commands(self) -> None:
+        """Handle every hand command waiting on the subscription (live thread)."""
+        take = self.subscription.handle.take_message
+        while (taken := take(HandCommand, False)) is not None:
+            self.on_command(taken[0])
+
+    def _contacts(self, ids: Any) -> list[_Contact]:
+        """The contacts a command names, in its order (empty: all, in the scene's order)."""
+        contacts = self.node.contacts
+        if not ids:
+            return [contacts[i] for i in self._order]
+        chosen = []
+        seen: set[str] = set()
+        for k, contact_id in enumerate(ids):
+            if contact_id not in contacts:
+                raise _HandError(
+                    f"contact_ids[{k}] '{contact_id}' is not a contact of this node "
+                    f"(contacts: {', '.join(self._order)})",
+                    contact_id,
+                )
+            if contact_id in seen:
+                raise _HandError(f"contact_ids[{k}] '{contact_id}' is listed twice", contact_id)
+            seen.add(contact_id)
+            chosen.append(contacts[contact_id])
+        return chosen
+
+    def on_command(self, msg: HandCommand) -> None:
+        """Step every contact of the command to its stamp and publish one HandState, or reject
+        it (no contact changes, one ContactEvent on ``hand/events`` with the reason)."""
+        node = self.node
+        stamp = msg.header.stamp
+        try:
+            contacts = self._contacts(msg.contact_ids)
+        except _HandError as error:
+            with node.hand_lock:
+                now_ns = node.now_ns()
+                node.record(self.command_topic, msg, now_ns)
+                index = self.commands_seen
+                self.commands_seen = index + 1
+                self._reject(str(error), error.contact_id, index, stamp, now_ns)
+            return
+        with node.hand_lock, contextlib.ExitStack() as locks:
+            # Sorted, as the parameter callback takes several contacts' locks.
+            for contact in sorted(contacts, key=lambda c: c.id):
+                locks.enter_context(contact.lock)
+            now_ns = node.now_ns()
+            node.record(self.command_topic, msg, now_ns)
+            index = self.commands_seen
+            self.commands_seen = index + 1
+            for contact in contacts:
+                contact._check_clock_locked(now_ns)
+            culprit = ""
+            try:
+                mode = msg.mode
+                values = self._values(msg, len(contacts), contacts)
+                epochs, stamps, targets = [], [], []
+                for contact in contacts:
+                    culprit = contact.id
+                    stamp_ns = contact._command_stamp_locked(stamp.sec, stamp.nanosec, now_ns)
+                    epoch_ns = stamp_ns if contact.last_command_ns is None else contact.epoch_ns
+                    epochs.append(epoch_ns)
+                    stamps.append(stamp_ns)
+                    targets.append(max((stamp_ns - epoch_ns) * 1e-9, contact.simulator.time))
+                culprit = ""
+                started = time.perf_counter()
+                outputs = step_contacts([c.simulator for c in contacts], targets, mode, values)
+                spent = (time.perf_counter() - started) / len(contacts)
+            except _HandError as error:
+                self._reject(str(error), error.contact_id, index, stamp, now_ns)
+                return
+            except ContactStepError as error:
+                culprit = contacts[error.index].id
+                self._reject(f"contact '{culprit}': {error}", culprit, index, stamp, now_ns)
+                return
+            except ValueError as error:
+                reason = f"contact '{culprit}': {error}" if culprit else str(error)
+                self._reject(reason, culprit, index, stamp, now_ns)
+                return
+            key = "depth" if mode == HandCommand.DEPTH else "force"
+            for contact, epoch_ns, stamp_ns, value in zip(contacts, epochs, stamps, values, strict=True):
+                contact.counters.steps.add(spent)
+                contact.accepted_locked(epoch_ns, stamp_ns, now_ns, {key: float(value)}, count=False)
+            self.commands_received += 1
+            stamp_ns = stamps[0]
+            payload = cdr.pack_hand_state(
+                stamp_ns,
+                node.frame_id,
+                [c.id for c in contacts],
+                _hand_columns(outputs, [c.simulator.model for c in contacts]),
+                self.commands_received,
+                self.commands_rejected,
+            )
+            self.state_pub.publish(payload)
+            node.record_cdr(self.state_topic, cdr.HAND_STATE, payload, now_ns)
+
+    @staticmethod
+    def _values(msg: HandCommand, count: int, contacts: list[_Contact]) -> Any:
+        """The mode's values, one finite number per contact; _HandError otherwise."""
+        if msg.mode == HandCommand.DEPTH:
+            name, values, other_name, other = "depth", msg.depth, "force", msg.force
+        elif msg.mode == HandCommand.FORCE:
+            name, values, other_name, other = "force", msg.force, "depth", msg.depth
+        else:
+            raise _HandError(
+                f"mode must be DEPTH ({HandCommand.DEPTH}) or FORCE ({HandCommand.FORCE}) (got {msg.mode})"
+            )
+        if len(values) != count:
+            raise _HandError(f"{name} has {len(values)} values for {count} contacts")
+        if len(other) not in (0, count):
+            raise _HandError(f"{other_name} has {len(other)} values for {count} contacts (give 0 or {count})")
+        for k, value in enumerate(values):
+            if not math.isfinite(value):
+                raise _HandError(
+                    f"{name}[{k}] (contact '{contacts[k].id}') must be finite (got {value})", contacts[k].id
+                )
+        return values
+
+    def _reject(self, reason: str, contact_id: str, index: int, stamp: Any, now_ns: int) -> None:
+        """Count, warn about and publish (and log) a rejected hand command."""
+        node = self.node
+        reason = f"hand command rejected: {reason}"
+        self.commands_rejected += 1
+        self.last_rejection = reason
+        node.get_logger().warning(reason, throttle_duration_sec=WARN_THROTTLE_S)
+        event = ContactEvent(
+            kind=ContactEvent.COMMAND_REJECTED, contact_id=contact_id, command_index=index, reason=reason
+        )
+        event.header.stamp = conversions.ns_to_stamp(now_ns)
+        event.header.frame_id = node.frame_id
+        event.command_stamp = stamp
+        self.events_pub.publish(event)
+        node.record(self.events_topic, event, now_ns)
+
+
+class _HandError(InputError):
+    """A hand command refused before any step; ``contact_id``: the contact it names, or ""."""
+
+    def __init__(self, message: str, contact_id: str = "") -> None:
+        super().__init__(message)
+        self.contact_id = contact_id
+
+
+def _hand_columns(outputs: list[StepOutput], models: list[str]) -> dict[str, list[Any]]:
+    """HandState's per-contact arrays from the step outputs."""
+    columns: dict[str, list[Any]] = {name: [] for name, _ in cdr.HAND_STATE_ARRAYS}
+    for output in outputs:
+        for name in conversions.STATE_OUTPUT_FIELDS:
+            columns[name].append(getattr(output, name))
+    columns["model"] = [conversions.MODEL_CODES[m] for m in models]
+    return columns
+
+
 class _LiveGroup(CallbackGroup):
     """Callback group of the live path's entities: never run by an executor (the executors
     leave out of their wait sets every entity whose group cannot execute), only by
@@ -561,7 +747,8 @@ class _LiveLoop:
 
     def _run(self) -> None:
         contacts = self._contacts
-        wait_set = _rclpy.WaitSet(len(contacts) + 1, 1, len(contacts), 0, 0, 0, self._node.context.handle)
+        hand = self._node.hand
+        wait_set = _rclpy.WaitSet(len(contacts) + 2, 1, len(contacts), 0, 0, 0, self._node.context.handle)
         try:
             while not self._stopping:
                 wait_set.clear_entities()
@@ -574,6 +761,7 @@ class _LiveLoop:
                             wait_set.add_subscription(clock.handle)
                         except InvalidHandle:
                             clock = None
+                    wait_set.add_subscription(hand.subscription.handle)
                     for contact in contacts:
                         wait_set.add_subscription(contact.subscription.handle)
                         wait_set.add_timer(contact.timer.handle)
@@ -585,6 +773,8 @@ class _LiveLoop:
                     if clock is not None and clock.handle.pointer in ready:
                         while (taken := clock.handle.take_message(Clock, clock.raw)) is not None:
                             clock.callback(taken[0])
+                if hand.subscription.handle.pointer in ready:
+                    hand.take_commands()
                 for contact in contacts:
                     if contact.subscription.handle.pointer in ready:
                         contact.take_commands()
@@ -623,8 +813,9 @@ class ViscoadhNode(Node):
         # MCAP logging; None while logging is off. Opened before the endpoints exist, so the
         # log holds every command received and every state and wrench published.
         events_qos = TopicQos(depth=EVENTS_QOS.depth, durability="transient_local")
+        events_topics = [f"{c.id}/events" for c in self.scene.contacts] + ["hand/events"]
         self._recorder: Recorder | None = _open_recorder(
-            self.scene, {self.resolve_topic_name(f"{c.id}/events"): events_qos for c in self.scene.contacts}
+            self.scene, {self.resolve_topic_name(topic): events_qos for topic in events_topics}
         )
         # Compile/load every numba kernel before the first command can arrive (~0.2 s).
         warm_up()
@@ -632,6 +823,9 @@ class ViscoadhNode(Node):
         self.services_group = ReentrantCallbackGroup()
         self.live_group = _LiveGroup()
         self.contacts = {c.id: _Contact(self, c) for c in self.scene.contacts}
+        # Held around a hand command (and nothing else): the hand's counters and event order.
+        self.hand_lock = threading.Lock()
+        self.hand = _Hand(self)
         self._jump_handler = self.get_clock().create_jump_callback(
             JumpThreshold(min_forward=None, min_backward=Duration(nanoseconds=-1)),
             post_callback=self._on_clock_jump,
