@@ -6,8 +6,8 @@ The contacts are standard solids with adhesion (``auto`` picks the time-stepped 
 from __future__ import annotations
 
 import pytest
+from scenes import one_contact
 
-from tests.scenes import one_contact
 from viscoadh_ros.core.errors import InputError
 from viscoadh_ros.core.hand import DEPTH, FORCE, ContactStepError, step_contacts
 from viscoadh_ros.core.simulator import ContactSimulator
