@@ -1,11 +1,13 @@
 """In-process profile of the node's live path: where one command's time goes, without DDS noise.
 
 The node runs on its own rclpy Context (discovery off) on the bench scene (N rate-dependent
-standard-solid contacts, MCAP logging on). The profile hands pre-built commands straight to the
-node's command handler, as the live thread does after taking them (1 kHz stamps per contact,
-the latency client's depth cycle), in ticks of one command per contact, and reads:
+standard-solid contacts, MCAP logging on), its live thread stopped. The profile hands pre-built
+commands (serialised, as the live thread takes them) straight to the node's command handler
+(1 kHz stamps per contact, the latency client's depth cycle), in ticks of one command per
+contact (or one HandCommand per tick with ``--hand``), and reads:
 
-- live-thread CPU and wall time per command (``time.thread_time`` / ``perf_counter``),
+- live-thread CPU and wall time per command (``time.thread_time`` / ``perf_counter``), and the
+  CPU of the same steps on bare simulators in the same thread (the core's share),
 - the MCAP writer thread's CPU per command (its thread CPU clock), which competes for the GIL,
 - with ``--cprofile``, the top functions of the command handler.
 
@@ -89,6 +91,9 @@ def profile_live(
                         contact = node.contacts[contact_id]
                         raw = getattr(contact, "on_raw_command", None)
                         feed.append((raw, serialize_message(msg)) if raw else (contact.on_command, msg))
+            # This thread does the live thread's work: stop the live thread, so no hold timer
+            # contends for the contacts' locks (on the node they run on one thread).
+            node._live.stop()
             recorder = node._recorder
             writer = recorder._thread if recorder is not None else None
             writer_cpu0 = _thread_cpu_s(writer) if writer is not None else 0.0
@@ -109,6 +114,16 @@ def profile_live(
                 time.sleep(0.05)
             writer_cpu = (_thread_cpu_s(writer) - writer_cpu0) if writer is not None else 0.0
             n = ticks * contacts
+            # The same steps on bare simulators, same thread: the core's share of the cost.
+            from viscoadh_ros.core.simulator import ContactSimulator
+
+            bare = [ContactSimulator(c) for c in scene.contacts]
+            depths = [depth_at(tick * 1e-3) for tick in range(ticks)]
+            core0 = time.thread_time()
+            for tick, depth in enumerate(depths):
+                for simulator in bare:
+                    simulator.step(tick * 1e-3, depth=depth)
+            core_cpu = (time.thread_time() - core0) / n * 1e6
             result: dict[str, Any] = {
                 "contacts": contacts,
                 "ticks": ticks,
@@ -118,6 +133,8 @@ def profile_live(
                 "live_cpu_us_per_command": (cpu1 - cpu0) / n * 1e6,
                 "live_wall_us_per_command": (wall1 - wall0) / n * 1e6,
                 "writer_cpu_us_per_command": writer_cpu / n * 1e6,
+                "core_step_cpu_us_per_command": core_cpu,
+                "node_overhead_cpu_us_per_command": (cpu1 - cpu0) / n * 1e6 - core_cpu,
                 "writer_backlog_at_end": backlog,
                 "log_dropped": recorder.dropped if recorder is not None else 0,
                 "step_mean_us": _step_mean_us(node),
