@@ -154,10 +154,10 @@ def test_hand_state_payload_is_what_rclpy_serialises(count: int, frame_id: str) 
     rng = np.random.default_rng(count)
     ids = [f"finger_{'x' * k}" for k in range(count)]
     columns = {}
-    for name, dtype in cdr.HAND_STATE_ARRAYS:
-        if dtype == "?":
+    for name, code in cdr.HAND_STATE_ARRAYS:
+        if code == "?":
             columns[name] = (rng.random(count) < 0.5).tolist()
-        elif dtype == "u1":
+        elif code == "B":
             columns[name] = rng.integers(0, 4, size=count).tolist()
         else:
             columns[name] = (rng.normal(size=count) * 1e-3).tolist()

@@ -16,6 +16,7 @@ different lengths in one batch) makes :func:`decode` return None, so callers fal
 
 from __future__ import annotations
 
+import functools
 import struct
 from collections.abc import Mapping, Sequence
 
@@ -130,6 +131,7 @@ class Packer:
         return bytes(buffer)
 
 
+_STAMP = struct.Struct("<iI")
 _COMMAND_HEAD = struct.Struct("<iII")  # stamp.sec, stamp.nanosec, frame_id length
 _COMMAND_VALUES = struct.Struct("<dd")  # depth, force
 
@@ -222,67 +224,73 @@ def encode_array(
 
 
 HAND_STATE = "viscoadh_msgs/msg/HandState"
-#: HandState's per-contact arrays after ``contact_ids``, in message order: (name, dtype).
+#: HandState's per-contact arrays after ``contact_ids``, in message order: (name, struct code).
 HAND_STATE_ARRAYS = (
-    ("depth", "<f8"),
-    ("force", "<f8"),
-    ("contact_radius", "<f8"),
-    ("phase", "u1"),
-    ("edge_speed", "<f8"),
-    ("effective_work_of_adhesion", "<f8"),
-    ("energy_input", "<f8"),
-    ("energy_dissipated", "<f8"),
+    ("depth", "d"),
+    ("force", "d"),
+    ("contact_radius", "d"),
+    ("phase", "B"),
+    ("edge_speed", "d"),
+    ("effective_work_of_adhesion", "d"),
+    ("energy_input", "d"),
+    ("energy_dissipated", "d"),
     ("scale_separation_ok", "?"),
     ("unstable", "?"),
-    ("model", "u1"),
+    ("model", "B"),
 )
 
 
-class _Builder:
-    """Little-endian CDR (XCDR1) written field by field, aligned from the end of the
-    encapsulation header."""
+@functools.lru_cache(maxsize=64)
+def _hand_state_layout(frame_id: str, contact_ids: tuple[str, ...]) -> tuple[bytes, struct.Struct]:
+    """The bytes of a HandState between its stamp and its arrays (frame_id, contact_ids), and
+    one ``struct`` for the rest (each array's length and values, the counters), with the CDR
+    alignment padding for this frame_id and these ids: a sample is then one struct call."""
+    out = bytearray(_ENCAPSULATION) + bytes(8)  # stamp, written per message
+    position = 8  # from the end of the encapsulation header
 
-    def __init__(self) -> None:
-        self.data = bytearray(_ENCAPSULATION)
+    def put_string(text: bytes) -> None:
+        nonlocal position
+        out.extend(bytes(-position % 4) + struct.pack("<I", len(text) + 1) + text + b"\x00")
+        position = len(out) - _HEADER
 
-    def align(self, size: int) -> None:
-        self.data += bytes(-(len(self.data) - _HEADER) % size)
-
-    def uint32(self, value: int) -> None:
-        self.align(4)
-        self.data += struct.pack("<I", value)
-
-    def string(self, text: bytes) -> None:
-        self.uint32(len(text) + 1)
-        self.data += text + b"\x00"
-
-    def array(self, values: ArrayLike, dtype: str) -> None:
-        column = np.ascontiguousarray(values, dtype=dtype)
-        self.uint32(column.size)
-        if column.size:
-            self.align(column.dtype.itemsize)
-            self.data += column.tobytes()
+    put_string(frame_id.encode())
+    out.extend(bytes(-position % 4) + struct.pack("<I", len(contact_ids)))
+    position = len(out) - _HEADER
+    for contact_id in contact_ids:
+        put_string(contact_id.encode())
+    prefix = bytes(out[_HEADER + 8 :])
+    count = len(contact_ids)
+    codes = ["<"]
+    for _, code in HAND_STATE_ARRAYS:
+        codes.append("x" * (-position % 4) + "I")
+        position += -position % 4 + 4
+        if count:
+            size = struct.calcsize(code)
+            codes.append("x" * (-position % size) + f"{count}{code}")
+            position += -position % size + count * size
+    codes.append("x" * (-position % 4) + "II")
+    return prefix, struct.Struct("".join(codes))
 
 
 def pack_hand_state(
     stamp_ns: int,
     frame_id: str,
     contact_ids: Sequence[str],
-    columns: Mapping[str, ArrayLike],
+    columns: Mapping[str, Sequence[float | int | bool]],
     commands_received: int,
     commands_rejected: int,
 ) -> bytes:
     """The CDR payload of a HandState: ``columns`` holds every name of
     :data:`HAND_STATE_ARRAYS` with one value per contact (a live path: a few microseconds,
     where filling 12 arrays of a rosidl message object and serialising it costs tens)."""
-    out = _Builder()
-    out.data += struct.pack("<iI", *divmod(stamp_ns, 1_000_000_000))
-    out.string(frame_id.encode())
-    out.uint32(len(contact_ids))
-    for contact_id in contact_ids:
-        out.string(contact_id.encode())
-    for name, dtype in HAND_STATE_ARRAYS:
-        out.array(columns[name], dtype)
-    out.uint32(commands_received)
-    out.uint32(commands_rejected)
-    return bytes(out.data)
+    prefix, layout = _hand_state_layout(frame_id, tuple(contact_ids))
+    count = len(contact_ids)
+    values: list[float | int | bool] = []
+    for name, _ in HAND_STATE_ARRAYS:
+        column = columns[name]
+        if len(column) != count:
+            raise ValueError(f"HandState.{name} has {len(column)} values for {count} contacts")
+        values.append(count)
+        values.extend(column)
+    values += (commands_received, commands_rejected)
+    return _ENCAPSULATION + _STAMP.pack(*divmod(stamp_ns, 1_000_000_000)) + prefix + layout.pack(*values)

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import contextlib
 import math
+import operator
 import sys
 import threading
 import time
@@ -674,14 +675,16 @@ class _HandError(InputError):
         self.contact_id = contact_id
 
 
-def _hand_columns(outputs: list[StepOutput], models: list[str]) -> dict[str, list[Any]]:
+def _hand_columns(outputs: list[StepOutput], models: list[str]) -> dict[str, Any]:
     """HandState's per-contact arrays from the step outputs."""
-    columns: dict[str, list[Any]] = {name: [] for name, _ in cdr.HAND_STATE_ARRAYS}
-    for output in outputs:
-        for name in conversions.STATE_OUTPUT_FIELDS:
-            columns[name].append(getattr(output, name))
+    rows = [_STATE_OUTPUTS(output) for output in outputs]
+    columns: dict[str, Any] = dict(zip(conversions.STATE_OUTPUT_FIELDS, zip(*rows, strict=True), strict=True))
     columns["model"] = [conversions.MODEL_CODES[m] for m in models]
     return columns
+
+
+#: The StepOutput fields a HandState carries, as a tuple per output.
+_STATE_OUTPUTS = operator.attrgetter(*conversions.STATE_OUTPUT_FIELDS)
 
 
 class _LiveGroup(CallbackGroup):
