@@ -334,9 +334,10 @@ def render_markdown(results: dict[str, Any], figure: Path | None, notes: str | N
         if "echo_p99_ms" in soak:
             # The echo node under the same load for as long, right after (same run).
             lines += [
-                f"- p99 {_g(soak['p99_ms'])} ms against the echo node's {_g(soak['echo_p99_ms'])} ms: "
-                f"ratio {_g(soak['p99_ratio'])} (target <= {P99_RATIO_TARGET:g}): "
-                f"{_mark(soak['p99_ratio'] <= P99_RATIO_TARGET)}",
+                f"- p99 of the answered commands {_g(soak['p99_ms'])} ms against the echo node's "
+                f"{_g(soak['echo_p99_ms'])} ms: ratio {_g(soak['p99_ratio'])} (target <= "
+                f"{P99_RATIO_TARGET:g}, nothing dropped): "
+                f"{_mark(soak['p99_ratio'] <= P99_RATIO_TARGET and soak['dropped'] == 0)}",
                 f"- deadline misses {_g(soak['deadline_miss_fraction'])} against the echo's "
                 f"{_g(soak['echo_deadline_miss_fraction'])} (target: at most 0.001 more): "
                 f"{_mark(soak['deadline_miss_fraction'] <= soak['echo_deadline_miss_fraction'] + 1e-3)}",
