@@ -245,3 +245,29 @@ def test_mixed_hand_and_contact_commands_keep_each_contacts_time_order(hand_setu
     ]
     # A contact's own counters count its own topic only (index rule of C/events).
     assert single.commands_received == 1 and single.commands_rejected == 1
+
+
+def test_the_log_holds_one_record_per_hand_command_and_state(
+    ros_context: Any, ros_executor: Any, spin_until: Any, tmp_path: Any
+) -> None:
+    from viscoadh_ros.io.bag import Bag
+
+    scene = _scene(4)
+    scene.update({"log.enabled": True, "log.path": str(tmp_path / "hand.mcap")})
+    node = _node(ros_context, scene)
+    ros_executor.add_node(node)
+    client = _Client(ros_context, ros_executor, spin_until, list(node.contacts))
+    sent = [_hand(client.t0 + k * 1_000_000, [DEPTH * k / 3] * 4) for k in range(3)]
+    states = [client.send(msg) for msg in sent]
+    assert all(state is not None for state in states)
+    assert client.send(_hand(client.t0 + 5_000_000, [DEPTH, math.inf, DEPTH, DEPTH])) is None
+    ros_executor.remove_node(node)
+    node.destroy_node()  # finishes the log
+    bag = Bag(tmp_path / "hand.mcap")
+    counts = {topic: bag.message_count(topic) for topic in bag.topics}
+    assert counts["/hand/indentation"] == 4 and counts["/hand/state"] == 3 and counts["/hand/events"] == 1
+    assert not any(topic.endswith(("/indentation", "/wrench")) and "hand" not in topic for topic in counts)
+    logged = [m.msg for m in bag.messages(["/hand/state"])]
+    assert [list(m.force) for m in logged] == [list(s.force) for s in states]
+    commands = [m.msg for m in bag.messages(["/hand/indentation"])]
+    assert [list(c.depth) for c in commands[:3]] == [list(m.depth) for m in sent]
