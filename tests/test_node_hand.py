@@ -271,3 +271,18 @@ def test_the_log_holds_one_record_per_hand_command_and_state(
     assert [list(m.force) for m in logged] == [list(s.force) for s in states]
     commands = [m.msg for m in bag.messages(["/hand/indentation"])]
     assert [list(c.depth) for c in commands[:3]] == [list(m.depth) for m in sent]
+
+
+def test_a_best_effort_hand_publisher_is_warned_about_naming_the_qos(
+    ros_context: Any, ros_executor: Any, spin_until: Any
+) -> None:
+    from rclpy.qos import qos_profile_sensor_data
+
+    node = _node(ros_context, _scene(1))
+    ros_executor.add_node(node)
+    controller = Node("sensor_data_hand", context=ros_context)
+    ros_executor.add_node(controller)
+    controller.create_publisher(HandCommand, "hand/indentation", qos_profile_sensor_data)
+    assert spin_until(ros_executor, lambda: "RELIABILITY" in node.hand.last_rejection, 3.0), (
+        "the incompatible hand publisher was not noticed"
+    )

@@ -527,11 +527,29 @@ class _Hand:
         self.state_pub = node.create_publisher(HandState, "hand/state", _QOS_DEPTH)
         self.events_pub = node.create_publisher(ContactEvent, "hand/events", EVENTS_QOS)
         self.subscription = node.create_subscription(
-            HandCommand, "hand/indentation", self.on_command, COMMAND_QOS, callback_group=node.live_group
+            HandCommand,
+            "hand/indentation",
+            self.on_command,
+            COMMAND_QOS,
+            callback_group=node.live_group,
+            event_callbacks=SubscriptionEventCallbacks(incompatible_qos=self.on_incompatible_qos),
         )
+        # As for C/indentation: the QoS events are served by the services' executor.
+        for handler in self.subscription.event_handlers:
+            handler.callback_group = node.services_group
+            node.services_group.add_entity(handler)
         self.command_topic = self.subscription.topic_name
         self.state_topic = self.state_pub.topic_name
         self.events_topic = self.events_pub.topic_name
+
+    def on_incompatible_qos(self, event: Any) -> None:
+        """A publisher on ``hand/indentation`` whose QoS cannot match: warn, naming the policy."""
+        policy = qos_policy_name_from_kind(event.last_policy_kind)
+        self.last_rejection = (
+            f"a publisher on {self.command_topic} offers a QoS incompatible with the node's (last "
+            f"incompatible policy: {policy}); its commands are not received. Publish reliable."
+        )
+        self.node.get_logger().warning(self.last_rejection)
 
     def take_commands(self) -> None:
         """Handle every hand command waiting on the subscription (live thread)."""
