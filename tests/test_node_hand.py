@@ -286,3 +286,24 @@ def test_a_best_effort_hand_publisher_is_warned_about_naming_the_qos(
     assert spin_until(ros_executor, lambda: "RELIABILITY" in node.hand.last_rejection, 3.0), (
         "the incompatible hand publisher was not noticed"
     )
+
+
+def test_diagnostics_show_a_rejected_hand_command(hand_setup: Any) -> None:
+    from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+
+    node, client, _ = hand_setup
+    statuses: list[Any] = []
+    client.node.create_subscription(
+        DiagnosticArray,
+        "/diagnostics",
+        lambda a: statuses.extend(s for s in a.status if s.name.endswith(": hand")),
+        10,
+    )
+    assert client.send(_hand(client.t0, [DEPTH, math.nan], ["c0", "c1"])) is None
+    assert client.spin_until(
+        client.executor, lambda: any(s.level == DiagnosticStatus.WARN for s in statuses), 3.0
+    ), "no WARN status for the hand topics after a rejected hand command"
+    warn = next(s for s in statuses if s.level == DiagnosticStatus.WARN)
+    assert warn.name == f"{node.get_fully_qualified_name()}: hand"
+    values = {v.key: v.value for v in warn.values}
+    assert values["commands_rejected"] == "1" and "must be finite" in values["last_rejection"]

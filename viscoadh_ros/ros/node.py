@@ -523,6 +523,8 @@ class _Hand:
         self.commands_received = 0
         self.commands_rejected = 0
         self.last_rejection = ""
+        self._rejected_reported = 0  # commands_rejected at the last /diagnostics status
+        self._qos_problems = 0  # incompatible publishers noticed since the last status
         self._order = list(node.contacts)
         self.state_pub = node.create_publisher(HandState, "hand/state", _QOS_DEPTH)
         self.events_pub = node.create_publisher(ContactEvent, "hand/events", EVENTS_QOS)
@@ -542,6 +544,20 @@ class _Hand:
         self.state_topic = self.state_pub.topic_name
         self.events_topic = self.events_pub.topic_name
 
+    def status(self, node_name: str) -> Any:
+        """The ``<node>: hand`` diagnostic status (WARN after a rejection since the last one)."""
+        with self.node.hand_lock:
+            window = self.commands_rejected - self._rejected_reported + self._qos_problems
+            self._rejected_reported = self.commands_rejected
+            self._qos_problems = 0
+            return diagnostics.hand_status(
+                node_name=node_name,
+                received=self.commands_received,
+                rejected=self.commands_rejected,
+                rejected_in_window=window,
+                last_rejection=self.last_rejection,
+            )
+
     def on_incompatible_qos(self, event: Any) -> None:
         """A publisher on ``hand/indentation`` whose QoS cannot match: warn, naming the policy."""
         policy = qos_policy_name_from_kind(event.last_policy_kind)
@@ -549,6 +565,7 @@ class _Hand:
             f"a publisher on {self.command_topic} offers a QoS incompatible with the node's (last "
             f"incompatible policy: {policy}); its commands are not received. Publish reliable."
         )
+        self._qos_problems += 1
         self.node.get_logger().warning(self.last_rejection)
 
     def take_commands(self) -> None:
@@ -903,6 +920,9 @@ class ViscoadhNode(Node):
 
     def _publish_diagnostics(self) -> None:
         statuses = [contact.status() for contact in self.contacts.values()]
+        hand = self.hand
+        if hand.commands_seen or hand.last_rejection:
+            statuses.append(hand.status(self.get_fully_qualified_name()))
         if self._recorder is not None:
             statuses.append(
                 diagnostics.log_status(
