@@ -315,3 +315,26 @@ def test_report_marks_targets() -> None:
     }
     text = report.render_markdown(results, None)
     assert "p99 ratio 2 (target <= 1.25): **missed**" in text
+
+
+def test_contacts_out_of_range_is_a_usage_error(capsys: pytest.CaptureFixture[str]) -> None:
+    with pytest.raises(SystemExit) as raised:
+        cli_main(["bench", "--contacts", "0"])
+    assert raised.value.code == 2
+    assert "--contacts must be in 1..256" in capsys.readouterr().err
+
+
+def test_hand_round_trips_are_one_per_tick(ros_env: dict[str, str]) -> None:
+    """Hand mode: one HandCommand for every contact per tick, echoed back on hand/echo."""
+    trips = measure_round_trips(
+        "echo",
+        contact_ids=["a", "b", "c"],
+        duration_s=0.5,
+        rate_hz=100.0,
+        depth_amplitude=1e-5,
+        domain_id=int(ros_env["ROS_DOMAIN_ID"]),
+        warmup_s=0.2,
+        hand=True,
+    )
+    assert trips.latency_s.size == 50, "one round trip per tick, not per contact"
+    assert trips.dropped == 0, "hand echoes lost or mismatched"

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
@@ -119,3 +120,53 @@ def test_experiment_reads_mixed_frames_through_rclpy(tmp_path: Any) -> None:
     np.testing.assert_array_equal(
         experiment.measured_ns, [10e9, 11e9, 12e9, 13e9 + 5], err_msg="header stamps, else log time"
     )
+
+
+@pytest.mark.parametrize("frame_id", ["", "a", "abc", "abcd", "hand_frame_01"])
+def test_parse_command_reads_what_rclpy_serialises(frame_id: str) -> None:
+    """The live path's raw command reader gives rclpy's fields for every frame_id padding."""
+    from rclpy.serialization import serialize_message
+    from viscoadh_msgs.msg import IndentationCommand
+
+    msg = IndentationCommand(mode=IndentationCommand.FORCE, depth=-1.5e-4, force=float("nan"))
+    msg.header.stamp.sec, msg.header.stamp.nanosec = 1_700_000_000, 999_999_999
+    msg.header.frame_id = frame_id
+    sec, nanosec, mode, depth, force = cdr.parse_command(serialize_message(msg))
+    assert (sec, nanosec, mode, depth) == (1_700_000_000, 999_999_999, IndentationCommand.FORCE, -1.5e-4)
+    assert math.isnan(force)
+
+
+def test_parse_command_leaves_other_layouts_to_rclpy() -> None:
+    from rclpy.serialization import serialize_message
+    from viscoadh_msgs.msg import IndentationCommand
+
+    payload = serialize_message(IndentationCommand(depth=1.0))
+    assert cdr.parse_command(b"\x00\x00\x00\x00" + payload[4:]) is None, "big endian"
+    assert cdr.parse_command(payload[:-1]) is None, "cut"
+    assert cdr.parse_command(payload + b"\x00" * 8) is None, "longer than the layout"
+
+
+@pytest.mark.parametrize("count", [0, 1, 3, 16])
+@pytest.mark.parametrize("frame_id", ["", "ab", "hand"])
+def test_hand_state_payload_is_what_rclpy_serialises(count: int, frame_id: str) -> None:
+    from viscoadh_msgs.msg import HandState
+
+    rng = np.random.default_rng(count)
+    ids = [f"finger_{'x' * k}" for k in range(count)]
+    columns = {}
+    for name, code in cdr.HAND_STATE_ARRAYS:
+        if code == "?":
+            columns[name] = (rng.random(count) < 0.5).tolist()
+        elif code == "B":
+            columns[name] = rng.integers(0, 4, size=count).tolist()
+        else:
+            columns[name] = (rng.normal(size=count) * 1e-3).tolist()
+    payload = cdr.pack_hand_state(1_234_567_890_123, frame_id, ids, columns, 7, 2)
+    msg = HandState(contact_ids=ids, commands_received=7, commands_rejected=2, **columns)
+    msg.header.stamp.sec, msg.header.stamp.nanosec = 1234, 567_890_123
+    msg.header.frame_id = frame_id
+    # Same fields (not the same bytes: rclpy leaves alignment padding uninitialised, and for
+    # empty arrays its buffer carries uninitialised bytes after the message).
+    back = deserialize_message(payload, HandState)
+    assert back == msg
+    assert list(back.contact_ids) == ids and list(back.force) == columns["force"]

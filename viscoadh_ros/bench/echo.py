@@ -1,7 +1,8 @@
 """The latency baseline: a minimal rclpy node that republishes every IndentationCommand untouched.
 
 For each contact id `C` it subscribes `C/indentation` and publishes the same message object on
-`C/echo` with the same QoS as the simulator node's topics. A client timing command -> echo round
+`C/echo`, and `hand/indentation` (HandCommand) back on `hand/echo`, with the same QoS as the
+simulator node's topics. A client timing command -> echo round
 trips measures the DDS + rclpy floor on this machine, to set beside the command -> state round
 trips of `viscoadh node` in the same run.
 
@@ -15,7 +16,7 @@ import sys
 import rclpy
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.node import Node
-from viscoadh_msgs.msg import IndentationCommand
+from viscoadh_msgs.msg import HandCommand, IndentationCommand
 
 # Same depth as the client's; a round trip never has more than a few messages in flight.
 QOS_DEPTH = 100
@@ -35,6 +36,9 @@ class EchoNode(Node):
                 lambda msg, pub=publisher: pub.publish(msg),
                 QOS_DEPTH,
             )
+        # The hand topic: every contact in one message (the node's hand/indentation).
+        hand = self.create_publisher(HandCommand, "hand/echo", QOS_DEPTH)
+        self.create_subscription(HandCommand, "hand/indentation", hand.publish, QOS_DEPTH)
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -150,10 +150,13 @@ def measure_round_trips(
     domain_id: int | None = None,
     warmup_s: float = 2.0,
     ready_timeout_s: float = 120.0,
+    hand: bool = False,
 ) -> RoundTrips:
     """Start `server` and a client in child processes and time every command's round trip.
 
     contact_ids: the contacts commanded (must be the scene's for the node server).
+    hand: one HandCommand for every contact per tick on `hand/indentation` (answered on
+    `hand/state`, or `hand/echo` by the echo node): one round trip per tick, not per contact.
     duration_s: measured phase, s (after the warm-up). rate_hz: commands per second per contact.
     depth_amplitude: the deepest commanded depth, m.
     Raises RuntimeError naming the process when the server or the client fails.
@@ -187,6 +190,7 @@ def measure_round_trips(
             repr(depth_amplitude),
             "--out",
             str(out_path),
+            *(["--hand"] if hand else []),
             *contact_ids,
         ]
         rss_time, rss = [], []
@@ -278,10 +282,16 @@ def write_scene(scene: dict[str, Any], path: Path) -> Path:
     return path
 
 
-def node_benchmark(*, contacts: int, duration_s: float, rate_hz: float = 1000.0) -> dict[str, Any]:
-    """The `node` results section: the node and then the echo node under the same load."""
-    scene, amplitude = bench_scene(contacts)
+def node_benchmark(
+    *, contacts: int, duration_s: float, rate_hz: float = 1000.0, hand: bool = False, log: bool = False
+) -> dict[str, Any]:
+    """The `node` results section: the node and then the echo node under the same load.
+
+    hand: drive every contact by one HandCommand per tick (`hand/indentation`) instead of one
+    IndentationCommand per contact; log: the node writes its MCAP log (to a temporary folder).
+    """
     with tempfile.TemporaryDirectory(prefix="viscoadh_bench_") as tmp:
+        scene, amplitude = bench_scene(contacts, log_path=Path(tmp) / "node.mcap" if log else None)
         scene_path = write_scene(scene, Path(tmp) / "scene.yaml")
         ids = scene["/**"]["ros__parameters"]["contacts"]
         node = measure_round_trips(
@@ -291,13 +301,21 @@ def node_benchmark(*, contacts: int, duration_s: float, rate_hz: float = 1000.0)
             rate_hz=rate_hz,
             depth_amplitude=amplitude,
             scene_path=scene_path,
+            hand=hand,
         )
         echo = measure_round_trips(
-            "echo", contact_ids=ids, duration_s=duration_s, rate_hz=rate_hz, depth_amplitude=amplitude
+            "echo",
+            contact_ids=ids,
+            duration_s=duration_s,
+            rate_hz=rate_hz,
+            depth_amplitude=amplitude,
+            hand=hand,
         )
     return {
         "contacts": contacts,
         "rate_hz": rate_hz,
         "duration_s": duration_s,
+        "hand": hand,
+        "log": log,
         **summarize_node_latency(node, echo, rate_hz=rate_hz),
     }

@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 import rclpy
 from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
-from viscoadh_msgs.msg import ContactState, IndentationCommand
+from viscoadh_msgs.msg import ContactState, HandCommand, HandState, IndentationCommand
 
 QOS_DEPTH = 100
 # Depth cycle the client drives: from 20% of the amplitude above the surface to the full amplitude
@@ -41,29 +41,40 @@ class _Client:
     publishing deadline and taking replies directly keeps the client thin and single-threaded.
     """
 
-    def __init__(self, contact_ids: list[str], reply: str, samples: int) -> None:
+    def __init__(self, contact_ids: list[str], reply: str, samples: int, *, hand: bool = False) -> None:
         self.node = rclpy.create_node("viscoadh_bench_client")
-        reply_type = ContactState if reply == "state" else IndentationCommand
-        self.publishers = [
-            self.node.create_publisher(IndentationCommand, f"{c}/indentation", QOS_DEPTH) for c in contact_ids
-        ]
+        # Hand mode: one HandCommand for every contact per tick on hand/indentation, answered on
+        # hand/state (node) or hand/echo (echo node); one "channel" in the tables below.
+        self.hand_contacts = len(contact_ids) if hand else 0
+        if hand:
+            reply_type = HandState if reply == "state" else HandCommand
+            self.publishers = [self.node.create_publisher(HandCommand, "hand/indentation", QOS_DEPTH)]
+            channels = ["hand"]
+        else:
+            reply_type = ContactState if reply == "state" else IndentationCommand
+            self.publishers = [
+                self.node.create_publisher(IndentationCommand, f"{c}/indentation", QOS_DEPTH)
+                for c in contact_ids
+            ]
+            channels = list(contact_ids)
         self.subscriptions = [
             self.node.create_subscription(reply_type, f"{c}/{reply}", lambda _msg: None, QOS_DEPTH)
-            for c in contact_ids
+            for c in channels
         ]
-        self.wait_set = _rclpy.WaitSet(len(contact_ids), 0, 0, 0, 0, 0, self.node.context.handle)
-        # Slot (sample index or PROBE) of each stamp awaiting its reply, per contact.
-        self.pending: list[dict[int, int]] = [{} for _ in contact_ids]
-        self.last_stamp = [0] * len(contact_ids)
+        self.wait_set = _rclpy.WaitSet(len(channels), 0, 0, 0, 0, 0, self.node.context.handle)
+        # Slot (sample index or PROBE) of each stamp awaiting its reply, per channel.
+        self.pending: list[dict[int, int]] = [{} for _ in channels]
+        self.last_stamp = [0] * len(channels)
         self.latency = np.full(samples, np.nan)
-        self.answered = [False] * len(contact_ids)
+        self.answered = [False] * len(channels)
         self.first_reply_wall = math.nan
 
     def publish(self, contact: int, depth: float, slot: int | None) -> None:
         """Publish a DEPTH command stamped with the wall time now; remember it under `slot`."""
-        msg = IndentationCommand()
-        msg.mode = IndentationCommand.DEPTH
-        msg.depth = depth
+        if self.hand_contacts:
+            msg = HandCommand(mode=HandCommand.DEPTH, depth=[depth] * self.hand_contacts)
+        else:
+            msg = IndentationCommand(mode=IndentationCommand.DEPTH, depth=depth)
         # Strictly increasing stamps: the node rejects a stamp older than the last one.
         stamp = max(time.time_ns(), self.last_stamp[contact] + 1)
         self.last_stamp[contact] = stamp
@@ -104,14 +115,14 @@ def run_client(args: argparse.Namespace) -> int:
     """The client process: wait for the server, warm up, publish at the rate, save samples."""
     period = 1.0 / args.rate
     n_ticks = max(1, round(args.duration * args.rate))
-    n_contacts = len(args.contact_ids)
+    n_contacts = 1 if args.hand else len(args.contact_ids)  # commands per tick
 
     def depth_at(t: float) -> float:
         phase = 0.5 - 0.5 * math.cos(2.0 * math.pi * t / CYCLE_PERIOD_S)
         return args.depth_amplitude * ((1.0 + LIFT_FRACTION) * phase - LIFT_FRACTION)
 
     rclpy.init()
-    client = _Client(args.contact_ids, args.reply, n_ticks * n_contacts)
+    client = _Client(args.contact_ids, args.reply, n_ticks * n_contacts, hand=args.hand)
     try:
         # Ready = a probe command came back on every contact (the server is up and serving).
         give_up = time.perf_counter() + args.ready_timeout
@@ -168,6 +179,7 @@ def _client_parser() -> argparse.ArgumentParser:
     parser.add_argument("--ready-timeout", type=float, required=True)
     parser.add_argument("--depth-amplitude", type=float, required=True)
     parser.add_argument("--out", type=Path, required=True)
+    parser.add_argument("--hand", action="store_true", help="one HandCommand for all contacts per tick")
     return parser
 
 

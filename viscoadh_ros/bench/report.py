@@ -348,7 +348,9 @@ def render_markdown(results: dict[str, Any], figure: Path | None, notes: str | N
             "## Node round trip through DDS",
             "",
             f"{node['contacts']} contacts at {node['rate_hz']:g} Hz for {node['duration_s']:g} s"
-            " each, client in its own process; the echo node republishes each command.",
+            " each, client in its own process; the echo node republishes each command."
+            + (" One HandCommand for every contact per tick (hand topics)." if node.get("hand") else "")
+            + (" The node writes its MCAP log." if node.get("log") else ""),
             "",
         ]
         lines += _table(
@@ -458,15 +460,33 @@ def render_markdown(results: dict[str, Any], figure: Path | None, notes: str | N
             "## Soak",
             "",
             f"Node under {soak['rate_hz']:g} Hz on {soak['contacts']} contacts with logging on "
-            f"for {soak['minutes']:g} min.",
+            f"for {soak['minutes']:g} min"
+            + (
+                " by the hand topic (one HandCommand for every contact per tick: a command below is a tick)."
+                if soak.get("hand")
+                else "."
+            ),
             "",
             f"- memory growth {soak['memory_growth']:.2%} (target < "
             f"{SOAK_MEMORY_GROWTH_TARGET:.0%}): {_mark(soak['memory_growth'] < SOAK_MEMORY_GROWTH_TARGET)}",
             f"- dropped {soak['dropped']} of {soak['commands_sent']}: {_mark(soak['dropped'] == 0)}",
             f"- p99 drift {soak['p99_drift']:.2%} (target < {SOAK_P99_DRIFT_TARGET:.0%}): "
             f"{_mark(abs(soak['p99_drift']) < SOAK_P99_DRIFT_TARGET)}",
-            "",
         ]
+        if "echo_p99_ms" in soak:
+            # The echo node under the same load for as long, right after (same run).
+            lines += [
+                f"- p99 of the answered commands {_g(soak['p99_ms'])} ms against the echo node's "
+                f"{_g(soak['echo_p99_ms'])} ms: ratio {_g(soak['p99_ratio'])} (target <= "
+                f"{P99_RATIO_TARGET:g}, nothing dropped): "
+                f"{_mark(soak['p99_ratio'] <= P99_RATIO_TARGET and soak['dropped'] == 0)}",
+                f"- deadline misses {_g(soak['deadline_miss_fraction'])} against the echo's "
+                f"{_g(soak['echo_deadline_miss_fraction'])} (target: at most 0.001 more): "
+                f"{_mark(soak['deadline_miss_fraction'] <= soak['echo_deadline_miss_fraction'] + 1e-3)}",
+                f"- echo node dropped {soak['echo_dropped']}; commands in the node's log "
+                f"{soak['logged_commands']}, recorder drops {soak.get('log_dropped')}",
+            ]
+        lines += [""]
     lines += [
         "## Stability at the extremes (property tests)",
         "",

@@ -1,8 +1,11 @@
-"""Soak: the node under 1 kHz commands on 8 contacts with MCAP logging on, for minutes.
+"""Soak: the node under 1 kHz commands on 8 contacts (or N) with MCAP logging on, for minutes.
 
 Reports the node's memory growth (resident set, median of the last tenth of the run against
 the first tenth after warm-up), the commands that got no state back, the p99 round trip of
-the first and last windows and its drift, and how many commands the node's log holds.
+the first and last windows and its drift, and how many commands the node's log holds; then
+the echo node under the same load for as long (unless ``echo=False``), and the node's p99 and
+deadline misses beside the echo's. With ``hand`` every tick is one HandCommand for all
+contacts (`hand/indentation`), one round trip and one logged command per tick.
 """
 
 from __future__ import annotations
@@ -28,12 +31,29 @@ def logged_commands(log_path: Path) -> int:
     return sum(bag.message_count(topic) for topic in bag.topics if topic.endswith("/indentation"))
 
 
+def logged_drops(log_path: Path) -> int | None:
+    """Messages the node's recorder dropped (its ``viscoadh_log`` record), None if absent."""
+    from mcap.reader import make_reader
+
+    from viscoadh_ros.io.mcap_log import DROPPED_KEY, LOG_RECORD_NAME
+
+    dropped = None
+    for path in [log_path] if log_path.is_file() else sorted(log_path.glob("*.mcap")):
+        with open(path, "rb") as stream:
+            for record in make_reader(stream).iter_metadata():
+                if record.name == LOG_RECORD_NAME:
+                    dropped = (dropped or 0) + int(record.metadata[DROPPED_KEY])
+    return dropped
+
+
 def soak(
     *,
     minutes: float,
     contacts: int = SOAK_CONTACTS,
     rate_hz: float = SOAK_RATE_HZ,
     domain_id: int | None = None,
+    hand: bool = False,
+    echo: bool = True,
 ) -> dict[str, Any]:
     """The `soak` results section (see the module docstring); `domain_id` None picks one."""
     duration = minutes * 60.0
@@ -41,30 +61,51 @@ def soak(
         log_path = Path(tmp) / "soak.mcap"
         scene, amplitude = bench_scene(contacts, log_path=log_path)
         scene_path = write_scene(scene, Path(tmp) / "scene.yaml")
+        ids = scene["/**"]["ros__parameters"]["contacts"]
         trips = measure_round_trips(
             "node",
-            contact_ids=scene["/**"]["ros__parameters"]["contacts"],
+            contact_ids=ids,
             duration_s=duration,
             rate_hz=rate_hz,
             depth_amplitude=amplitude,
             scene_path=scene_path,
             warmup_s=WARMUP_S,
             domain_id=domain_id,
+            hand=hand,
         )
         logged = logged_commands(log_path)
+        log_dropped = logged_drops(log_path)
+        echo_trips = (
+            measure_round_trips(
+                "echo",
+                contact_ids=ids,
+                duration_s=duration,
+                rate_hz=rate_hz,
+                depth_amplitude=amplitude,
+                warmup_s=WARMUP_S,
+                domain_id=domain_id,
+                hand=hand,
+            )
+            if echo
+            else None
+        )
     measured = trips.rss_time_s >= trips.startup_s + WARMUP_S
     rss = trips.rss_bytes[measured]
     tenth = max(1, rss.size // 10)
     first, last = float(np.median(rss[:tenth])), float(np.median(rss[-tenth:]))
     window = max(5.0, duration / 10.0)
     p99 = trips.window_p99_ms(window)
-    return {
+    answered = trips.latency_s[~np.isnan(trips.latency_s)]
+    result: dict[str, Any] = {
         "minutes": minutes,
         "contacts": contacts,
         "rate_hz": rate_hz,
+        "hand": hand,
         "commands_sent": int(trips.latency_s.size),
         "dropped": trips.dropped,
         "logged_commands": logged,
+        "log_dropped": log_dropped,
+        "p99_ms": float(np.percentile(answered, 99.0)) * 1e3 if answered.size else float("nan"),
         "rss_start_mb": first / 1e6,
         "rss_end_mb": last / 1e6,
         "memory_growth": (last - first) / first,
@@ -74,3 +115,10 @@ def soak(
         "p99_drift": (p99[-1] - p99[0]) / p99[0],
         "deadline_miss_fraction": trips.deadline_miss_fraction(1.0 / rate_hz),
     }
+    if echo_trips is not None:
+        echoed = echo_trips.latency_s[~np.isnan(echo_trips.latency_s)]
+        result["echo_p99_ms"] = float(np.percentile(echoed, 99.0)) * 1e3 if echoed.size else float("nan")
+        result["p99_ratio"] = result["p99_ms"] / result["echo_p99_ms"]
+        result["echo_dropped"] = echo_trips.dropped
+        result["echo_deadline_miss_fraction"] = echo_trips.deadline_miss_fraction(1.0 / rate_hz)
+    return result

@@ -113,6 +113,9 @@ def run(
     sections: Sequence[str],
     soak_minutes: float | None,
     command: str,
+    contacts: int | None = None,
+    hand: bool = False,
+    node_log: bool = False,
     progress: Callable[[str], None],
 ) -> dict[str, Any]:
     """Run the chosen sections (plus the soak when asked) and return the results dictionary.
@@ -170,8 +173,14 @@ def run(
     if "node" in sections:
         from viscoadh_ros.bench.latency import node_benchmark
 
-        progress(f"node: {plan.node_duration_s:g} s of 1 kHz commands, node then echo")
-        results["node"] = node_benchmark(contacts=plan.node_contacts, duration_s=plan.node_duration_s)
+        count = contacts or plan.node_contacts
+        progress(
+            f"node: {plan.node_duration_s:g} s of 1 kHz commands on {count} contacts"
+            f"{' by the hand topic' if hand else ''}{' with logging' if node_log else ''}, node then echo"
+        )
+        results["node"] = node_benchmark(
+            contacts=count, duration_s=plan.node_duration_s, hand=hand, log=node_log
+        )
         results["startup_s"] = results["node"]["startup_s"]
     if "replay" in sections:
         from viscoadh_ros.bench.replay_speed import replay_benchmark
@@ -200,10 +209,14 @@ def run(
             samples=plan.fit_samples, starts=plan.fit_starts, kelvin_starts=plan.fit_kelvin_starts
         )
     if soak_minutes is not None:
-        from viscoadh_ros.bench.soak import soak
+        from viscoadh_ros.bench.soak import SOAK_CONTACTS, soak
 
-        progress(f"soak: {soak_minutes:g} min on 8 contacts with logging on")
-        results["soak"] = soak(minutes=soak_minutes)
+        count = contacts or SOAK_CONTACTS
+        progress(
+            f"soak: {soak_minutes:g} min on {count} contacts{' by the hand topic' if hand else ''} "
+            "with logging on, then the echo node as long"
+        )
+        results["soak"] = soak(minutes=soak_minutes, contacts=count, hand=hand)
     run_info = {key: results[key] for key in RUN_KEYS}
     results["runs"] = {name: dict(run_info) for name in SECTION_KEYS if name in results}
     return results

@@ -1,6 +1,7 @@
 """`viscoadh bench`: measure speed and accuracy on this machine, write BENCHMARKS.md and JSON.
 
     viscoadh bench [--quick] [--json FILE] [--output FILE] [--soak MINUTES] [--sections LIST]
+                   [--contacts N] [--hand] [--node-log]
 
 A full run writes BENCHMARKS.md (tables, with the accuracy figure under the JSON's folder) and
 benchmarks/results.json; `--quick` (under about three minutes) writes only what is asked for
@@ -37,6 +38,16 @@ def _positive_minutes(text: str) -> float:
     return value
 
 
+def _contact_count(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"--contacts must be a whole number (got {text!r})") from None
+    if not 1 <= value <= 256:
+        raise argparse.ArgumentTypeError(f"--contacts must be in 1..256 (got {text!r})")
+    return value
+
+
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     from viscoadh_ros.bench.suite import SECTIONS
 
@@ -49,7 +60,23 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--soak",
         type=_positive_minutes,
         metavar="MINUTES",
-        help="also run the node for MINUTES under 1 kHz on 8 contacts with logging on",
+        help="also run the node MINUTES at 1 kHz on 8 contacts (or --contacts), logging on, then echo",
+    )
+    parser.add_argument(
+        "--contacts",
+        type=_contact_count,
+        metavar="N",
+        help="contacts of the node section and the soak (default: 4 and 8)",
+    )
+    parser.add_argument(
+        "--hand",
+        action="store_true",
+        help="node section and soak: one HandCommand for all contacts per tick (hand/indentation)",
+    )
+    parser.add_argument(
+        "--node-log",
+        action="store_true",
+        help="node section: the node writes its MCAP log (the soak always does)",
     )
     parser.add_argument(
         "--render",
@@ -105,9 +132,15 @@ def _command_line(args: argparse.Namespace, sections: list[str]) -> str:
     words = ["viscoadh", "bench"]
     if args.quick:
         words.append("--quick")
-    for flag, value in (("--json", args.json), ("--output", args.output), ("--soak", args.soak)):
+    for flag, value in (
+        ("--json", args.json),
+        ("--output", args.output),
+        ("--soak", args.soak),
+        ("--contacts", args.contacts),
+    ):
         if value is not None:
             words += [flag, str(value)]
+    words += [flag for flag, on in (("--hand", args.hand), ("--node-log", args.node_log)) if on]
     if tuple(sections) != SECTIONS:
         words += ["--sections", ",".join(sections)]
     return shlex.join(words)
@@ -171,6 +204,9 @@ def main(args: argparse.Namespace) -> int:
             suite.QUICK if args.quick else suite.FULL,
             sections=sections,
             soak_minutes=args.soak,
+            contacts=args.contacts,
+            hand=args.hand,
+            node_log=args.node_log,
             command=command,
             progress=lambda message: print(f"viscoadh bench: {message}", file=sys.stderr, flush=True),
         )

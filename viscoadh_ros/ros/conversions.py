@@ -49,14 +49,19 @@ def command_control(msg: IndentationCommand) -> dict[str, float]:
 
     Raises InputError for an unknown mode or a non-finite value of the mode's field.
     """
-    if msg.mode == IndentationCommand.DEPTH:
-        name, value = "depth", msg.depth
-    elif msg.mode == IndentationCommand.FORCE:
-        name, value = "force", msg.force
+    return control_of(msg.mode, msg.depth, msg.force)
+
+
+def control_of(mode: int, depth: float, force: float) -> dict[str, float]:
+    """:func:`command_control` of a command's ``mode``, ``depth`` and ``force`` fields."""
+    if mode == IndentationCommand.DEPTH:
+        name, value = "depth", depth
+    elif mode == IndentationCommand.FORCE:
+        name, value = "force", force
     else:
         raise InputError(
             f"mode must be DEPTH ({IndentationCommand.DEPTH}) or FORCE "
-            f"({IndentationCommand.FORCE}) (got {msg.mode})"
+            f"({IndentationCommand.FORCE}) (got {mode})"
         )
     if not math.isfinite(value):
         raise InputError(f"{name} must be finite (got {value})")
@@ -65,11 +70,16 @@ def command_control(msg: IndentationCommand) -> dict[str, float]:
 
 def describe_command(msg: IndentationCommand) -> str:
     """A command in a few words for a rejection reason: ``depth 1e+10 m``, ``force nan N``."""
-    if msg.mode == IndentationCommand.DEPTH:
-        return f"depth {msg.depth:g} m"
-    if msg.mode == IndentationCommand.FORCE:
-        return f"force {msg.force:g} N"
-    return f"mode {msg.mode}"
+    return describe(msg.mode, msg.depth, msg.force)
+
+
+def describe(mode: int, depth: float, force: float) -> str:
+    """:func:`describe_command` of a command's ``mode``, ``depth`` and ``force`` fields."""
+    if mode == IndentationCommand.DEPTH:
+        return f"depth {depth:g} m"
+    if mode == IndentationCommand.FORCE:
+        return f"force {force:g} N"
+    return f"mode {mode}"
 
 
 def contact_state(

@@ -131,3 +131,24 @@ def log_status(
         message=message,
         values=[KeyValue(key=k, value=v) for k, v in values.items()],
     )
+
+
+def hand_status(
+    *, node_name: str, received: int, rejected: int, rejected_in_window: int, last_rejection: str
+) -> DiagnosticStatus:
+    """The status of the hand topics (``<node name>: hand``): WARN when a hand command was
+    rejected (or a publisher's QoS could not match) since the last status, else OK."""
+    values = {
+        "commands_received": str(received),
+        "commands_rejected": str(rejected),
+        "last_rejection": last_rejection,
+    }
+    return DiagnosticStatus(
+        level=DiagnosticStatus.WARN if rejected_in_window else DiagnosticStatus.OK,
+        name=f"{node_name}: hand",
+        hardware_id="hand",
+        message=f"{rejected_in_window} hand command(s) rejected: {last_rejection}"
+        if rejected_in_window
+        else "OK",
+        values=[KeyValue(key=k, value=v) for k, v in values.items()],
+    )
