@@ -260,3 +260,34 @@ def test_events_log_every_rejection_reset_and_parameter_change_in_order(
     forces = [m.msg.force for m in bag.messages(["/elastic/state"]) if m.msg.commands_received == 3]
     expected = ContactSimulator(stored.contacts[0]).step(0.0, depth=5e-6).force
     np.testing.assert_allclose(forces[-1], expected, rtol=1e-12, err_msg="after the change")
+
+
+def test_a_rejection_reason_prints_the_stamps_to_the_nanosecond(
+    ros_context: Any, ros_executor: Any, spin_until: Any
+) -> None:
+    """The reason gives both stamps digit for digit (a float printed a 2026 stamp's last
+    nanoseconds wrong: ...045717001 for ...045717063)."""
+    _node(ros_context, ros_executor)
+    client = EventClient(ros_context, ros_executor, spin_until)
+    last = client.t0 - client.t0 % 10**9 + 125_717_163
+    older = last - 80_000_100
+    assert client.send(_command(last, depth=1e-6)) is not None
+    assert client.send(_command(older, depth=2e-6), expect_state=False) is None
+    reason = client.rejected(1).reason
+    for ns in (older, last):
+        assert f"{ns // 10**9}.{ns % 10**9:09d} s" in reason, reason
+
+
+def test_state_stamps_never_go_back_after_a_command_stamped_ahead(
+    ros_context: Any, ros_executor: Any, spin_until: Any
+) -> None:
+    """A command stamped 0.4 s ahead (within command.max_future_s) is answered with its stamp;
+    the hold timer (50 Hz here) must not then publish states stamped now, behind it."""
+    _node(ros_context, ros_executor, {**FAULT_SCENE, "publish_rate": 50.0})
+    client = EventClient(ros_context, ros_executor, spin_until, ahead_ns=400_000_000)
+    assert client.send(_command(client.t0, depth=5e-6)) is not None
+    deadline = time.monotonic() + 0.6
+    spin_until(client.executor, lambda: time.monotonic() > deadline, 2.0)
+    stamps = [s.header.stamp.sec * 10**9 + s.header.stamp.nanosec for s in client.states]
+    assert len(stamps) >= 2, "the timer published after the clock caught up"
+    assert all(b >= a for a, b in zip(stamps, stamps[1:])), np.diff(stamps)

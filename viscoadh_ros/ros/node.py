@@ -85,6 +85,14 @@ GIL_SWITCH_INTERVAL_S = 1e-4
 _COMMAND_TYPE = "viscoadh_msgs/msg/IndentationCommand"
 
 
+def _seconds(ns: int) -> str:
+    """A node-clock time in ns as seconds with all nine decimals, exactly (a float's 16 digits
+    change the last nanoseconds of a 2026 stamp, and users compare these with their stamps)."""
+    sign = "-" if ns < 0 else ""
+    whole, frac = divmod(abs(ns), _NS_PER_S)
+    return f"{sign}{whole}.{frac:09d}"
+
+
 class Recorder(Protocol):
     """What the node hands every message it receives and publishes to (MCAP logging)."""
 
@@ -326,14 +334,14 @@ class _Contact:
         stamp_ns = sec * _NS_PER_S + nanosec or now_ns
         if stamp_ns - now_ns > self.node.max_future_ns:
             raise InputError(
-                f"header.stamp {stamp_ns * 1e-9:.9f} s is {(stamp_ns - now_ns) * 1e-9:.3f} s ahead of the "
-                f"node clock ({now_ns * 1e-9:.9f} s); command.max_future_s allows "
+                f"header.stamp {_seconds(stamp_ns)} s is {(stamp_ns - now_ns) * 1e-9:.3f} s ahead of the "
+                f"node clock ({_seconds(now_ns)} s); command.max_future_s allows "
                 f"{self.node.max_future_ns * 1e-9:g} s"
             )
         if self.last_command_ns is not None and stamp_ns < self.last_command_ns:
             raise InputError(
-                f"header.stamp {stamp_ns * 1e-9:.9f} s is older than the last "
-                f"command's {self.last_command_ns * 1e-9:.9f} s"
+                f"header.stamp {_seconds(stamp_ns)} s is older than the last "
+                f"command's {_seconds(self.last_command_ns)} s"
             )
         return stamp_ns
 
@@ -354,6 +362,11 @@ class _Contact:
             # No command since start or reset: the contact is out of touch and there is nothing
             # to hold (holding depth 0 would touch the surface, and an adhesive contact snaps in).
             target = self._sim_time(now_ns)
+            if target < self.simulator.time:
+                # A command stamped ahead of the clock (within command.max_future_s) put the
+                # contact ahead of now, and its state went out with that stamp: a state stamped
+                # now would describe a later time and make the state stamps go backwards.
+                return
             output = self.simulator.output
             if target > self.simulator.time:
                 started = time.perf_counter()
