@@ -290,4 +290,4 @@ def test_state_stamps_never_go_back_after_a_command_stamped_ahead(
     spin_until(client.executor, lambda: time.monotonic() > deadline, 2.0)
     stamps = [s.header.stamp.sec * 10**9 + s.header.stamp.nanosec for s in client.states]
     assert len(stamps) >= 2, "the timer published after the clock caught up"
-    assert all(b >= a for a, b in zip(stamps, stamps[1:])), np.diff(stamps)
+    assert np.all(np.diff(stamps) >= 0), np.diff(stamps)
