@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 import pytest
 import yaml
-from diagnostic_msgs.msg import DiagnosticArray
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from mcap.reader import make_reader
 from rclpy.parameter import Parameter
 from rclpy.qos import qos_profile_sensor_data
@@ -291,3 +291,39 @@ def test_state_stamps_never_go_back_after_a_command_stamped_ahead(
     stamps = [s.header.stamp.sec * 10**9 + s.header.stamp.nanosec for s in client.states]
     assert len(stamps) >= 2, "the timer published after the clock caught up"
     assert np.all(np.diff(stamps) >= 0), np.diff(stamps)
+
+
+def test_diagnostics_warn_when_a_press_leaves_the_models_validity(
+    ros_context: Any, ros_executor: Any, spin_until: Any
+) -> None:
+    """A press so deep that the sphere's flank at the contact edge is steep (depth 0.5 R: slope
+    ~0.7 > 0.3) is still answered, but /diagnostics says the state is outside the small-slope
+    assumption; a shallow press is OK. (Elastic sphere: closed-form path.)"""
+    from rclpy.node import Node
+
+    _node(ros_context, ros_executor)
+    client = EventClient(ros_context, ros_executor, spin_until)
+    probe = Node("probe", context=ros_context)
+    ros_executor.add_node(probe)
+    statuses: list[Any] = []
+    probe.create_subscription(
+        DiagnosticArray,
+        "/diagnostics",
+        lambda a: statuses.extend(s for s in a.status if s.name.endswith(": elastic")),
+        10,
+    )
+
+    def latest() -> dict[str, str]:
+        return {kv.key: kv.value for kv in statuses[-1].values} if statuses else {}
+
+    assert client.send(_command(client.t0, depth=5e-6)) is not None
+    statuses.clear()
+    assert spin_until(ros_executor, lambda: latest().get("in_contact") == "True", 4.0)
+    ok = statuses[-1]
+    assert latest()["small_slope_ok"] == "True" and ok.level == DiagnosticStatus.OK, ok.message
+    assert client.send(_command(client.t0 + 10_000_000, depth=5e-3)) is not None
+    statuses.clear()
+    assert spin_until(ros_executor, lambda: bool(statuses), 4.0)
+    status = statuses[-1]
+    assert latest()["small_slope_ok"] == "False" and status.level == DiagnosticStatus.WARN, status.message
+    assert "flank slope" in status.message and "small slopes" in status.message, status.message

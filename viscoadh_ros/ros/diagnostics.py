@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 
+from viscoadh_ros.core.simulator import ModelValidity
 from viscoadh_ros.ros.conversions import ns_to_stamp
 
 
@@ -68,25 +69,28 @@ def contact_status(
     *,
     node_name: str,
     model: str,
-    scale_separation_ok: bool,
+    validity: ModelValidity,
     in_contact: bool,
 ) -> DiagnosticStatus:
     """The status of one contact; takes (and resets) the step-time and rejection windows.
 
-    Level WARN when the energy criterion's scale separation does not hold or something was
-    rejected since the last report, else OK.
+    Level WARN when the current state lies outside the model's validity (flank slope at the
+    contact edge beyond the small-slope limit, or no scale separation of the energy criterion:
+    `ContactSimulator.model_validity`) or something was rejected since the last report, else OK.
     """
     steps, mean, maximum = counters.steps.take()
     problems = []
-    if not scale_separation_ok:
-        problems.append("scale separation of the energy criterion violated")
+    if not validity.ok:
+        problems.append(f"outside the model's validity: {validity.message}")
     if counters.rejections_in_window:
         problems.append(f"{counters.rejections_in_window} rejected (last: {counters.last_rejection})")
     counters.rejections_in_window = 0
     values = {
         "model": model,
         "in_contact": str(in_contact),
-        "scale_separation_ok": str(scale_separation_ok),
+        "scale_separation_ok": str(validity.scale_separation_ok),
+        "small_slope_ok": str(validity.small_slope_ok),
+        "edge_slope": f"{validity.edge_slope:.3g}",
         "steps_in_window": str(steps),
         "step_time_mean_us": f"{mean * 1e6:.1f}",
         "step_time_max_us": f"{maximum * 1e6:.1f}",

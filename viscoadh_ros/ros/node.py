@@ -506,13 +506,12 @@ class _Contact:
 
     def status(self) -> Any:
         with self.lock:
-            output = self.simulator.output
             return diagnostics.contact_status(
                 self.id,
                 self.counters,
                 node_name=self.node.get_fully_qualified_name(),
                 model=self.simulator.model,
-                scale_separation_ok=bool(output.scale_separation_ok),
+                validity=self.simulator.model_validity,
                 in_contact=self.simulator.in_contact,
             )
 
