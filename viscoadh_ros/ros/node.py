@@ -362,7 +362,7 @@ class _Contact:
             # No command since start or reset: the contact is out of touch and there is nothing
             # to hold (holding depth 0 would touch the surface, and an adhesive contact snaps in).
             target = self._sim_time(now_ns)
-            if target < self.simulator.time:
+            if self.last_command_ns is not None and target < self.simulator.time:
                 # A command stamped ahead of the clock (within command.max_future_s) put the
                 # contact ahead of now, and its state went out with that stamp: a state stamped
                 # now would describe a later time and make the state stamps go backwards.
