@@ -62,12 +62,18 @@ OUT_SUBSTEPS = 4
 #: Energy dissipated over the step, J (>= 0: viscous work plus adhesion hysteresis).
 OUT_DISSIPATED = 5
 OUT_MEMORY = 6
-OUT_SIZE = 7
+#: Criterion gap h at the new edge with the exterior and the interior memory, m
+#: (`criterion_gap`; 0 without contact): the phase of a pinned edge needs them.
+OUT_GAP_OUTSIDE = 7
+OUT_GAP_INSIDE = 8
+#: Profile g at the new edge, m (fine-grid interpolation, as the kernel sees it; 0 without contact).
+OUT_G_EDGE = 9
+OUT_SIZE = 10
 
-#: Columns of `_advance_rows`'s per-row output: the `out` slots, then the edge gaps.
-ROW_GAP_OUTSIDE = OUT_SIZE
-ROW_GAP_INSIDE = OUT_SIZE + 1
-ROW_SIZE = OUT_SIZE + 2
+#: Columns of `_advance_rows`'s per-row output: the `out` slots (gaps included).
+ROW_GAP_OUTSIDE = OUT_GAP_OUTSIDE
+ROW_GAP_INSIDE = OUT_GAP_INSIDE
+ROW_SIZE = OUT_SIZE
 
 # Substep attempts per `advance` after which the edge-motion limit is dropped for the rest of
 # the step: a guard (never reached in the test suite) so that an edge criterion flipping back
@@ -746,6 +752,21 @@ def _restore_state(wl, wsum, wb, bsum, src, src_b):
 
 
 @numba.njit(cache=True, nogil=True)
+def _edge_outputs(a, d, wsum, bsum, dx, g_c, gf, df, c_crit, out):
+    """Write the edge gaps on both sides and g at the edge into ``out`` (zeros without contact)."""
+    if a > 0.0:
+        n = wsum.shape[0]
+        n_in = _interior_count(a, dx, n)
+        out[OUT_GAP_OUTSIDE] = _h(a, d, wsum, bsum, n_in, n - 1, dx, g_c, gf, df, c_crit)
+        out[OUT_GAP_INSIDE] = _h(a, d, wsum, bsum, 0, n_in - 1, dx, g_c, gf, df, c_crit)
+        out[OUT_G_EDGE] = _g_at(a, gf, df)
+    else:
+        out[OUT_GAP_OUTSIDE] = 0.0
+        out[OUT_GAP_INSIDE] = 0.0
+        out[OUT_G_EDGE] = 0.0
+
+
+@numba.njit(cache=True, nogil=True)
 def _advance(
     wl,
     wsum,
@@ -788,8 +809,9 @@ def _advance(
     of them, down to ``1e-7 dt``: a true jump (snap-in, the fold at pull-off) is thereby
     located in time and crossed in one tiny substep that does no work. Writes radius,
     force, work input, last motion, substep count, the energy dissipated over the step
-    (>= 0) and the largest |wsum| to ``out``. Returns STATUS_GROW (state partly advanced:
-    the caller restores) when the contact needs a larger domain.
+    (>= 0), the largest |wsum|, the edge gaps and g at the edge to ``out``. Returns
+    STATUS_GROW (state partly advanced: the caller restores) when the contact needs a larger
+    domain.
     """
     n = wl.shape[0]
     h_min = dt * 1e-7
@@ -839,6 +861,7 @@ def _advance(
         out[OUT_SUBSTEPS] = 0
         out[OUT_DISSIPATED] = max(hysteresis, 0.0)
         out[OUT_MEMORY] = _memory_peak(wsum)
+        _edge_outputs(new_a, d1, wsum, bsum, dx, g_c, gf, df, c_crit, out)
         return STATUS_OK
     while tau < dt:
         h = step
@@ -905,6 +928,7 @@ def _advance(
     out[OUT_SUBSTEPS] = substeps
     out[OUT_DISSIPATED] = lost
     out[OUT_MEMORY] = _memory_peak(wsum)
+    _edge_outputs(a, d1, wsum, bsum, dx, g_c, gf, df, c_crit, out)
     return STATUS_OK
 
 
@@ -963,7 +987,6 @@ def _advance_rows(
     ContactSimulator does) or STATUS_GROW (memory restored: the caller grows the domain and
     calls again from row i).
     """
-    n = wl.shape[0]
     for i in range(first, times.shape[0]):
         d1 = depths[i]
         if a <= 0.0 and peak <= idle_limit and d1 < 0.0 and d_prev < 0.0:
@@ -1009,11 +1032,6 @@ def _advance_rows(
         peak = out[OUT_MEMORY]
         for k in range(OUT_SIZE):
             rows[i, k] = out[k]
-        if a > 0.0:
-            # Only a contact's pinned edge needs them (the phase); none without contact.
-            n_in = _interior_count(a, dx, n)
-            rows[i, ROW_GAP_OUTSIDE] = _h(a, d1, wsum, bsum, n_in, n - 1, dx, g_c, gf, df, c_crit)
-            rows[i, ROW_GAP_INSIDE] = _h(a, d1, wsum, bsum, 0, n_in - 1, dx, g_c, gf, df, c_crit)
         t_prev = times[i]
         d_prev = d1
     return times.shape[0], STATUS_OK
@@ -1209,6 +1227,9 @@ class Row:
         self.bsum = self.wb.sum(axis=1)
         self.scratch = np.empty_like(self.wl)
         self.scratch_b = np.empty_like(self.wl)
+        # The simulator's transaction journal: the memory before a step's first kernel call.
+        self.txn = np.empty_like(self.wl)
+        self.txn_b = np.empty_like(self.wl)
         self.diss = np.zeros(n)
         self.p, self.p_inv, self.lam, self.beta, self.rate = p, p_inv, lam, beta, rate
         self.e_kelvin, self.steady = e_kelvin, steady
@@ -1274,6 +1295,8 @@ class Row:
         clone.bsum = np.empty_like(self.bsum)
         clone.scratch = np.empty_like(self.scratch)
         clone.scratch_b = np.empty_like(self.scratch_b)
+        clone.txn = np.empty_like(self.txn)
+        clone.txn_b = np.empty_like(self.txn_b)
         clone.diss = np.zeros_like(self.diss)
         clone.out = np.zeros(OUT_SIZE)
         clone.set_memory(wl, wb)

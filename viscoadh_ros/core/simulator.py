@@ -90,6 +90,16 @@ class StepOutput:
 
 STEP_OUTPUT_FIELDS = tuple(f.name for f in fields(StepOutput))
 
+
+def _new_output(*values: Any) -> StepOutput:
+    """A StepOutput from its field values in order, without the frozen dataclass's
+    ``__init__`` (one ``object.__setattr__`` per field, the larger part of a step's Python
+    cost): the instance is the same (same fields, equality, hash, repr)."""
+    output = object.__new__(StepOutput)
+    output.__dict__.update(zip(STEP_OUTPUT_FIELDS, values, strict=True))
+    return output
+
+
 #: Largest flank slope f'(a) at the contact edge for which the half-space (small-slope) theory
 #: behind MDR is taken as valid: its neglected terms grow like the slope squared (a sphere at
 #: a/R = 0.3 is Hertz within a few percent).
@@ -301,8 +311,19 @@ class _ClosedForm:
         gap = self._gap(depth, self.radius)
         return gap, gap
 
+    def edge_height(self, radius: float) -> float:
+        """Profile g at `radius`, m."""
+        return float(self.physics.profile.g(radius))
+
     def is_relaxed(self) -> bool:
         return True
+
+    def begin(self) -> float:
+        """Start a transaction (`ContactSimulator.step`): the token `rollback` takes."""
+        return self.radius
+
+    def rollback(self, token: float) -> None:
+        self.radius = token
 
     def get_state(self) -> float:
         return self.radius
@@ -350,6 +371,12 @@ class _TimeStepped:
         self.dissipated = 0.0
         # Largest |wsum| (m) the last `advance` left, None once the state changed otherwise.
         self._memory_peak: float | None = None
+        # The transaction journal (`begin`/`rollback`): the row whose `txn` buffers hold its
+        # memory from before the transaction's first kernel call, None before that call.
+        self._journal: _kernels.Row | None = None
+        # Edge outputs of the last `advance` (gaps outside/inside, g at the edge) and its depth.
+        self._edge = (0.0, 0.0, 0.0)
+        self._edge_depth = math.nan
 
     # -- the domain ---------------------------------------------------------------------
     def _build_row(
@@ -431,7 +458,16 @@ class _TimeStepped:
             self.substeps = 0
             return 0.0, 0.0, 0.0
         assert self.row is not None
-        start = self.get_state()
+        row = self.row
+        if self._journal is not row:
+            # First kernel call of the transaction on this row: journal its memory (compiled
+            # copy into preallocated buffers) instead of a snapshot of numpy copies.
+            _kernels._copy_state(row.wl, row.wb, row.txn, row.txn_b)
+            self._journal = row
+            start = None
+        else:
+            start = self.get_state()
+        radius0, dissipated0 = self.radius, self.dissipated
         while True:
             row = self.row
             # The kernel itself, not the validating wrapper: the row's arrays are checked
@@ -447,22 +483,29 @@ class _TimeStepped:
             )
             if status == _kernels.STATUS_OK:
                 break
-            self.set_state(start)
+            if start is None:
+                _kernels._restore_state(row.wl, row.wsum, row.wb, row.bsum, row.txn, row.txn_b)
+            else:
+                self.set_state(start)
+            self.radius, self.dissipated = radius0, dissipated0
             self._grow(d0)
             start = self.get_state()
-        out = row.out
-        self.radius = float(out[_kernels.OUT_RADIUS])
-        self.substeps = int(out[_kernels.OUT_SUBSTEPS])
-        self.dissipated += float(out[_kernels.OUT_DISSIPATED])
-        self._memory_peak = float(out[_kernels.OUT_MEMORY])
-        return self.radius, float(out[_kernels.OUT_FORCE]), float(out[_kernels.OUT_WORK])
+        radius, force, work, _, substeps, dissipated, peak, outside, inside, g_edge = row.out.tolist()
+        self.radius = radius
+        self.substeps = int(substeps)
+        self.dissipated += dissipated
+        self._memory_peak = peak
+        self._edge = (outside, inside, g_edge)
+        self._edge_depth = d1
+        return radius, force, work
 
     def advance_rows(
         self, sim: ContactSimulator, times: np.ndarray, depths: np.ndarray
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Advance through a depth history from ``sim``'s time and depth as `sim._trial`
         then `advance` would row by row; returns per row (radius m, force N, work J, energy
-        dissipated since the last reset J, edge gaps (n, 2) m: exterior, interior memory).
+        dissipated since the last reset J, edge gaps and g at the edge (n, 3) m: exterior
+        memory, interior memory, profile).
         Rows without a row (no domain yet, or idle above the surface) cost nothing here
         either."""
         n = times.size
@@ -521,7 +564,7 @@ class _TimeStepped:
             out[:, _kernels.OUT_FORCE].copy(),
             out[:, _kernels.OUT_WORK].copy(),
             dissipated,
-            rows[:, _kernels.ROW_GAP_OUTSIDE :].copy(),
+            rows[:, _kernels.OUT_GAP_OUTSIDE : _kernels.OUT_G_EDGE + 1].copy(),
         )
 
     def stored_energy(self, depth: float) -> float:
@@ -538,10 +581,37 @@ class _TimeStepped:
     def edge_gaps(self, depth: float) -> tuple[float, float]:
         """h at the edge with the exterior and with the interior memory, m."""
         assert self.row is not None
+        if depth == self._edge_depth:
+            return self._edge[0], self._edge[1]  # the last advance computed them
         return (
             _kernels.criterion_gap(self.row, self.radius, depth, self.radius, interior=False),
             _kernels.criterion_gap(self.row, self.radius, depth, self.radius, interior=True),
         )
+
+    def edge_height(self, radius: float) -> float:
+        """Profile g at the edge `radius` (m), m, as the kernel sees it (fine grid)."""
+        if radius == self.radius and self._edge_depth == self._edge_depth and radius > 0.0:
+            return self._edge[2]
+        if self.row is None or radius <= 0.0:
+            return float(self.physics.profile.g(radius))
+        return float(_kernels._g_at(radius, self.row.gf, self.row.df))
+
+    def begin(self) -> tuple:
+        """Start a transaction (`ContactSimulator.step`): a token of the scalars; the memory
+        is journalled by the first kernel call (`advance`), so a step that succeeds copies
+        nothing but that."""
+        self._journal = None
+        return (self.radius, self.row, self.dissipated, self._memory_peak, self._edge, self._edge_depth)
+
+    def rollback(self, token: tuple) -> None:
+        """Undo everything since `begin` returned `token`."""
+        journal = self._journal
+        if journal is not None:
+            _kernels._restore_state(
+                journal.wl, journal.wsum, journal.wb, journal.bsum, journal.txn, journal.txn_b
+            )
+            self._journal = None
+        self.radius, self.row, self.dissipated, self._memory_peak, self._edge, self._edge_depth = token
 
     def is_relaxed(self) -> bool:
         if self.row is None:
@@ -568,6 +638,7 @@ class _TimeStepped:
         self.radius = radius
         self.dissipated = dissipated
         self._memory_peak = None
+        self._edge_depth = math.nan
         if row is None:
             self.row = None
         elif row is self.row:
@@ -582,6 +653,8 @@ class _TimeStepped:
         self.row = None
         self.dissipated = 0.0
         self._memory_peak = None
+        self._journal = None
+        self._edge_depth = math.nan
 
 
 def _columns(outputs: list[StepOutput]) -> dict[str, np.ndarray]:
@@ -744,11 +817,19 @@ class ContactSimulator:
         """Advance to `time` (s) under displacement control (`depth`, m) or force control
         (`force`, N); exactly one of them. Returns the new StepOutput. On any error the
         state is left as it was before the call."""
-        snapshot = self.snapshot()
+        saved = (
+            self._model.begin(),
+            self._time,
+            self._depth,
+            self._output,
+            self._energy_input,
+            self._held_force,
+        )
         try:
             return self._step(time, depth, force)
         except BaseException:
-            self.restore(snapshot)
+            self._model.rollback(saved[0])
+            self._time, self._depth, self._output, self._energy_input, self._held_force = saved[1:]
             raise
 
     def _step(self, time: float, depth: float | None, force: float | None) -> StepOutput:
@@ -813,7 +894,7 @@ class ContactSimulator:
         r0 = np.concatenate(([self._output.contact_radius], radius[:-1]))
         dt = np.diff(t, prepend=self._time)
         energy_input = np.cumsum(np.concatenate(([self._energy_input], work)))[1:]
-        g = np.asarray(physics.profile.g(radius), dtype=np.float64)
+        g = gaps[:, 2]  # g at the edge as the kernel saw it (0 without contact), like `step`
         tol = 1e-9 * (np.abs(d) + physics.c_crit * np.sqrt(radius) + g)
         pinned = np.where(
             gaps[:, 0] >= -tol, Phase.INDENTING, np.where(gaps[:, 1] <= tol, Phase.DETACHING, Phase.STICKING)
@@ -880,6 +961,7 @@ class ContactSimulator:
         self, time: float, depth: float, force: float, r0: float, radius: float, dt: float, unstable: bool
     ) -> StepOutput:
         physics = self.physics
+        g_edge = self._model.edge_height(radius) if radius > 0.0 else 0.0
         if radius <= 0.0:
             phase = Phase.NO_CONTACT
         elif radius > r0:
@@ -889,7 +971,7 @@ class ContactSimulator:
         else:
             # Pinned edge: say which criterion it rests on, if any (elastic contacts at
             # rest sit on both; a punch rim blocks attachment).
-            tol = 1e-9 * (abs(depth) + physics.c_crit * math.sqrt(radius) + float(physics.profile.g(radius)))
+            tol = 1e-9 * (abs(depth) + physics.c_crit * math.sqrt(radius) + g_edge)
             outside, inside = self._model.edge_gaps(depth)
             if outside >= -tol:
                 phase = Phase.INDENTING
@@ -899,18 +981,20 @@ class ContactSimulator:
                 phase = Phase.STICKING
         edge_speed = (radius - r0) / dt if dt > 0.0 else 0.0
         dissipated = self._model.energy_dissipated(self._energy_input, depth)
-        return StepOutput(
-            time=time,
-            depth=depth,
-            force=force,
-            contact_radius=radius,
-            phase=phase,
-            edge_speed=edge_speed,
-            effective_work_of_adhesion=physics.effective_work(depth, radius),
-            energy_input=self._energy_input,
-            energy_dissipated=dissipated,
-            scale_separation_ok=physics.scale_separation_ok(edge_speed),
-            unstable=unstable,
+        u = depth - g_edge
+        effective = physics.e_relaxed * u * u / (2.0 * math.pi * radius) if radius > 0.0 and u < 0.0 else 0.0
+        return _new_output(
+            time,
+            depth,
+            force,
+            radius,
+            phase,
+            edge_speed,
+            effective,
+            self._energy_input,
+            dissipated,
+            physics.scale_separation_ok(edge_speed),
+            unstable,
         )
 
     # -- force control ----------------------------------------------------------------------
