@@ -86,6 +86,11 @@ _SERIES_LIMIT = 1e-4
 # Below this the dissipation integrals `_psi` use their (alternating, fast) series.
 _PSI_SERIES_LIMIT = 0.5
 
+#: A true jump of the edge (snap-in, the fold at pull-off) is located in time to this
+#: fraction of the step: the substep that crosses it is this short (its work is a
+#: trapezoid over a depth change this small), found by halving from the whole step.
+JUMP_RESOLUTION = 1e-4
+
 #: Edge roots are bisected to this fraction of an element width.
 EDGE_TOLERANCE = 1e-12
 
@@ -258,17 +263,84 @@ def _bisect(x_lo, x_hi, d, wsum, bsum, lo, hi, dx, g_c, gf, df, c_crit):
 
 
 @numba.njit(cache=True, nogil=True)
-def _scan_out(x_start, d, wsum, bsum, lo, hi, dx, g_c, gf, df, c_crit, reach):
-    """Outermost point of the h >= 0 run that starts at x_start (exterior memory): scan
-    the fine grid outward.
+def _h_bounds(b, d, wsum, bsum, lo, hi, dx, g_c, gf, gmin, gmax, df, c_crit):
+    """Lower and upper bounds of h at the fine points of block b (`TOUCH_BLOCK` points)
+    with the memory of elements lo..hi, m.
+
+    ``h = d - A(x) + c sqrt(x) - g(x) (1 - B(x))``; B (`_side_ab`) is linear between element
+    centres and on the extrapolated ends, A too up to the chord correction below, so at the
+    block's points they lie between their values at the block's end points and at the
+    centres inside it (A widened by that correction); g lies in
+    the block's ``[gmin, gmax]``; sqrt is increasing. A margin covers the rounding of the
+    interpolations, so a bound never excludes a point the point-by-point test would find.
+    """
+    m = gf.shape[0]
+    j0 = b * TOUCH_BLOCK
+    j1 = min(j0 + TOUCH_BLOCK, m) - 1
+    x0 = j0 * df
+    x1 = j1 * df
+    a_lo, b_lo = _side_ab(x0, wsum, bsum, lo, hi, dx, g_c)
+    a_hi, b_hi = _side_ab(x1, wsum, bsum, lo, hi, dx, g_c)
+    a_least = min(a_lo, a_hi)
+    a_most = max(a_lo, a_hi)
+    b_least = min(b_lo, b_hi)
+    b_most = max(b_lo, b_hi)
+    i_first = max(int(math.ceil(x0 / dx - 0.5)), lo)
+    i_last = min(int(x1 / dx - 0.5), hi)
+    for i in range(i_first, i_last + 1):
+        a_i = wsum[i] + g_c[i] * bsum[i]
+        a_least = min(a_least, a_i)
+        a_most = max(a_most, a_i)
+        b_least = min(b_least, bsum[i])
+        b_most = max(b_most, bsum[i])
+    # Between two centres A = w_lin + g_lin B_lin is not linear: it departs from the chord
+    # of its node values by t (1 - t) dg dB, at most |dg dB| / 4.
+    slack = 0.0
+    for i in range(max(i_first - 1, lo), min(i_last, hi - 1) + 1):
+        slack = max(slack, 0.25 * abs((g_c[i + 1] - g_c[i]) * (bsum[i + 1] - bsum[i])))
+    a_least -= slack
+    a_most += slack
+    p1 = gmin[b] * (1.0 - b_most)
+    p2 = gmin[b] * (1.0 - b_least)
+    p3 = gmax[b] * (1.0 - b_most)
+    p4 = gmax[b] * (1.0 - b_least)
+    prod_least = min(min(p1, p2), min(p3, p4))
+    prod_most = max(max(p1, p2), max(p3, p4))
+    margin = 1e-12 * (abs(d) + abs(a_most) + abs(a_least) + abs(gmax[b]) + c_crit * math.sqrt(x1))
+    lower = d - a_most + c_crit * math.sqrt(x0) - prod_most - margin
+    upper = d - a_least + c_crit * math.sqrt(x1) - prod_least + margin
+    return lower, upper
+
+
+@numba.njit(cache=True, nogil=True)
+def _scan_out(x_start, d, wsum, bsum, lo, hi, dx, g_c, gf, gmin, gmax, df, c_crit, reach, x_stop):
+    """Outermost point of the h >= 0 run that starts at x_start (exterior memory): the
+    first fine point beyond x_start where h < 0, bisected against the point before.
+
+    Whole blocks of `TOUCH_BLOCK` fine points whose lower bound of h (`_h_bounds`) is >= 0
+    are stepped over: the same point as a point-by-point scan, found in O(blocks + points
+    of one block) (a snap-in or a fast edge no longer scans the fine grid per substep).
 
     Returns ``(radius, grow)``; ``grow`` is True when h stays >= 0 up to the end of the
-    domain (the contact wants to pass L) and the profile still reaches further.
+    domain (the contact wants to pass L) and the profile still reaches further. Once the
+    run is known to pass ``x_stop`` the scan stops and returns a point beyond it (the
+    caller only needs to know that the edge moved that far).
     """
     m = gf.shape[0]
     j = int(x_start / df) + 1
     prev = x_start
     while j < m:
+        if prev > x_stop:
+            return prev, False
+        if j % TOUCH_BLOCK == 0:
+            b = j // TOUCH_BLOCK
+            j_end = min(j + TOUCH_BLOCK, m) - 1
+            if j_end * df < reach * (1.0 - 1e-12):
+                lower, _ = _h_bounds(b, d, wsum, bsum, lo, hi, dx, g_c, gf, gmin, gmax, df, c_crit)
+                if lower >= 0.0:
+                    prev = j_end * df
+                    j = j_end + 1
+                    continue
         xj = j * df
         # A domain that ends at the reach (flat punch: L = a0) must not ask to grow
         # because the last fine point fell a rounding error short of it.
@@ -341,8 +413,12 @@ def _first_touch(d, wsum, bsum, dx, g_c, gf, gmin, gmax, df, reach):
 
 
 @numba.njit(cache=True, nogil=True)
-def _locate_edge(a, d, wsum, bsum, dx, g_c, gf, gmin, gmax, df, c_crit, reach):
-    """Apply the energy criterion both ways at depth d. Returns (new radius, motion, grow)."""
+def _locate_edge(a, d, wsum, bsum, dx, g_c, gf, gmin, gmax, df, c_crit, reach, max_move):
+    """Apply the energy criterion both ways at depth d. Returns (new radius, motion, grow).
+
+    An edge that moves more than ``max_move`` (m; inf: no limit) is not located: a radius
+    beyond that distance is returned (the caller halves the substep anyway), so a substep
+    that a jump rejects costs O(max_move), not a scan to the far root and its bisection."""
     n = wsum.shape[0]
     n_in = _interior_count(a, dx, n)
     if a <= 0.0:
@@ -351,7 +427,9 @@ def _locate_edge(a, d, wsum, bsum, dx, g_c, gf, gmin, gmax, df, c_crit, reach):
         j = _first_touch(d, wsum, bsum, dx, g_c, gf, gmin, gmax, df, reach)
         if j < 0:
             return 0.0, MOTION_NONE, False
-        radius, grow = _scan_out(j * df, d, wsum, bsum, 0, n - 1, dx, g_c, gf, df, c_crit, reach)
+        radius, grow = _scan_out(
+            j * df, d, wsum, bsum, 0, n - 1, dx, g_c, gf, gmin, gmax, df, c_crit, reach, max_move
+        )
         if radius <= 0.0 and not grow:
             # Touching exactly at the apex without adhesion: no area, no contact.
             return 0.0, MOTION_NONE, False
@@ -361,11 +439,22 @@ def _locate_edge(a, d, wsum, bsum, dx, g_c, gf, gmin, gmax, df, c_crit, reach):
     # (Elements that just let go sit at the attachment threshold; the other order lets the
     # discretised exterior memory re-attach them and the receding edge chatter.)
     if _h(a, d, wsum, bsum, 0, n_in - 1, dx, g_c, gf, df, c_crit) < 0.0:
+        # Inward, the first fine point where h >= 0; whole blocks whose upper bound of h is
+        # below 0 (`_h_bounds`) are stepped over (the same point as point by point).
         j = int(a / df)
         if j * df >= a:
             j -= 1
         upper = a
         while j >= 0:
+            if upper < a - max_move:
+                return upper, MOTION_DETACH, False
+            if (j + 1) % TOUCH_BLOCK == 0:
+                b = j // TOUCH_BLOCK
+                _, top = _h_bounds(b, d, wsum, bsum, 0, n_in - 1, dx, g_c, gf, gmin, gmax, df, c_crit)
+                if top < 0.0:
+                    upper = b * TOUCH_BLOCK * df
+                    j = b * TOUCH_BLOCK - 1
+                    continue
             xj = j * df
             if _h(xj, d, wsum, bsum, 0, n_in - 1, dx, g_c, gf, df, c_crit) >= 0.0:
                 radius = _bisect(xj, upper, d, wsum, bsum, 0, n_in - 1, dx, g_c, gf, df, c_crit)
@@ -375,7 +464,9 @@ def _locate_edge(a, d, wsum, bsum, dx, g_c, gf, gmin, gmax, df, c_crit, reach):
         return 0.0, MOTION_DETACH, False
     # Attachment of exterior elements, judged with the exterior (residual) memory.
     if a < reach and _h(a, d, wsum, bsum, n_in, n - 1, dx, g_c, gf, df, c_crit) > 0.0:
-        radius, grow = _scan_out(a, d, wsum, bsum, n_in, n - 1, dx, g_c, gf, df, c_crit, reach)
+        radius, grow = _scan_out(
+            a, d, wsum, bsum, n_in, n - 1, dx, g_c, gf, gmin, gmax, df, c_crit, reach, a + max_move
+        )
         return radius, MOTION_ATTACH, grow
     return a, MOTION_NONE, False
 
@@ -806,7 +897,7 @@ def _advance(
     step's scalars (radius a, d0, d1, dt, max_substep, max_edge_move).
 
     Substeps are halved while the edge would move more than ``max_edge_move`` (m) in one
-    of them, down to ``1e-7 dt``: a true jump (snap-in, the fold at pull-off) is thereby
+    of them, down to ``JUMP_RESOLUTION dt``: a true jump (snap-in, the fold at pull-off) is thereby
     located in time and crossed in one tiny substep that does no work. Writes radius,
     force, work input, last motion, substep count, the energy dissipated over the step
     (>= 0), the largest |wsum|, the edge gaps and g at the edge to ``out``. Returns
@@ -814,7 +905,7 @@ def _advance(
     domain.
     """
     n = wl.shape[0]
-    h_min = dt * 1e-7
+    h_min = dt * JUMP_RESOLUTION
     step = dt if max_substep <= 0.0 or max_substep > dt else max_substep
     tau = 0.0
     force_prev = _force(a, d0, wsum, bsum, dx, g_c, gf, gint, df, e0, kap)
@@ -824,7 +915,9 @@ def _advance(
     substeps = 0
     attempts = 0
     if dt <= 0.0:
-        new_a, motion, grow = _locate_edge(a, d1, wsum, bsum, dx, g_c, gf, gmin, gmax, df, c_crit, reach)
+        new_a, motion, grow = _locate_edge(
+            a, d1, wsum, bsum, dx, g_c, gf, gmin, gmax, df, c_crit, reach, math.inf
+        )
         if grow:
             return STATUS_GROW
         # The elements that switch at a jump in depth switch at the new depth.
@@ -875,11 +968,26 @@ def _advance(
         _kelvin_update(
             wl, wsum, wb, bsum, diss, n_in, da, db, h, g_c, p, p_inv, lam, beta, rate, e_kelvin, dx
         )
-        new_a, sub_motion, grow = _locate_edge(a, db, wsum, bsum, dx, g_c, gf, gmin, gmax, df, c_crit, reach)
+        limited = h > h_min and attempts + 1 < _MAX_ATTEMPTS
+        new_a, sub_motion, grow = _locate_edge(
+            a,
+            db,
+            wsum,
+            bsum,
+            dx,
+            g_c,
+            gf,
+            gmin,
+            gmax,
+            df,
+            c_crit,
+            reach,
+            max_edge_move if limited else math.inf,
+        )
         if grow:
             return STATUS_GROW
         attempts += 1
-        if abs(new_a - a) > max_edge_move and h > h_min and attempts < _MAX_ATTEMPTS:
+        if abs(new_a - a) > max_edge_move and limited:
             _restore_state(wl, wsum, wb, bsum, scratch, scratch_b)
             step = 0.5 * h
             continue
@@ -917,10 +1025,17 @@ def _advance(
         force_prev = force_new
         if sub_motion != MOTION_NONE:
             motion = sub_motion
+        jumped = abs(new_a - a) > max_edge_move
         a = new_a
         tau += h
         substeps += 1
-        step = min(2.0 * h, dt if max_substep <= 0.0 else max_substep)
+        # After a jump (a substep at the shortest length that still moved the edge more than
+        # the limit: snap-in or the fold) try the whole rest of the step at once instead of
+        # doubling back up from 1e-7 dt (about 23 more substeps); the halving catches an edge
+        # that keeps moving fast.
+        step = dt if jumped else 2.0 * h
+        if max_substep > 0.0 and step > max_substep:
+            step = max_substep
     out[OUT_RADIUS] = a
     out[OUT_FORCE] = force_prev
     out[OUT_WORK] = work
@@ -1380,6 +1495,7 @@ def locate_edge(row: Row, radius: float, depth: float) -> tuple[float, int, bool
         row.df,
         row.c_crit,
         row.reach,
+        math.inf,
     )
     return float(new_radius), int(motion), bool(grow)
 

@@ -322,6 +322,10 @@ class _ClosedForm:
         """Start a transaction (`ContactSimulator.step`): the token `rollback` takes."""
         return self.radius
 
+    def rewind(self, state: float) -> None:
+        """`set_state` for a trial of the force search (the state is one of this model's)."""
+        self.radius = state
+
     def rollback(self, token: float) -> None:
         self.radius = token
 
@@ -363,6 +367,12 @@ class _TimeStepped:
             self.initial_length = 0.0  # chosen from the depth at first contact
         if self.punch_radius is not None:
             self.initial_length = min(self.initial_length, self.punch_radius)
+        # The first contact's domain, built once here (about 0.1 ms: the fine profile grid and
+        # its checks) rather than inside the snap-in step; each new contact takes a copy of
+        # it with zero memory.
+        self._template: _kernels.Row | None = None
+        if self.initial_length > 0.0:
+            self._template = self._build_row(self.initial_length, None)
         self.row: _kernels.Row | None = None
         self.radius = 0.0
         self.substeps = 0
@@ -444,11 +454,12 @@ class _TimeStepped:
             return True
         if depth < 0.0:
             return False
-        length = self.initial_length
-        if length <= 0.0:
-            length = 1.25 * float(self.physics.profile.radius_at_height(depth))
-            if not length > 0.0:
-                return False
+        if self._template is not None:
+            self.row = self._template.with_memory(np.zeros_like(self._template.wl))
+            return True
+        length = 1.25 * float(self.physics.profile.radius_at_height(depth))
+        if not length > 0.0:
+            return False
         self.row = self._build_row(length, None)
         return True
 
@@ -596,6 +607,20 @@ class _TimeStepped:
             return float(self.physics.profile.g(radius))
         return float(_kernels._g_at(radius, self.row.gf, self.row.df))
 
+    def rewind(self, state: tuple) -> None:
+        """Back to `state` (from `get_state` of this model) for the next trial of the force
+        search: the memory copied back in compiled code, without `set_state`'s validation
+        (the arrays are the model's own copies) when the row is still the same."""
+        radius, row, memory, unit, dissipated = state
+        if row is None or row is not self.row:
+            self.set_state(state)
+            return
+        _kernels._restore_state(row.wl, row.wsum, row.wb, row.bsum, memory, unit)
+        self.radius = radius
+        self.dissipated = dissipated
+        self._memory_peak = None
+        self._edge_depth = math.nan
+
     def begin(self) -> tuple:
         """Start a transaction (`ContactSimulator.step`): a token of the scalars; the memory
         is journalled by the first kernel call (`advance`), so a step that succeeds copies
@@ -655,6 +680,49 @@ class _TimeStepped:
         self._memory_peak = None
         self._journal = None
         self._edge_depth = math.nan
+
+
+def _bracketed_root(
+    residual: Any, a: float, fa: float, b: float, fb: float, tol: float
+) -> tuple[float, float]:
+    """A root of `residual` in the bracket [a, b] (``fa``, ``fb`` of opposite signs):
+    Illinois (regula falsi that halves the stale end's value) with a bisection whenever the
+    bracket failed to halve in three steps. Stops when ``|residual| <= tol`` (N, the force
+    tolerance) or the bracket is down to 1e-15 relative (a jump across the target: the
+    caller flags it). Returns (x, residual(x)) of the best point (the smaller |residual|)."""
+    # ra, rb: the true residuals at a and b; fa, fb: the (Illinois-weighted) ones the
+    # interpolation uses.
+    ra, rb = fa, fb
+    side = 0
+    width = abs(b - a)
+    since_halved = 0
+    for _ in range(200):
+        if abs(ra) <= tol:
+            return a, ra
+        if abs(rb) <= tol:
+            return b, rb
+        if abs(b - a) <= 1e-15 * max(abs(a), abs(b), 1e-300):
+            break
+        x = (a * fb - b * fa) / (fb - fa) if since_halved < 3 else 0.5 * (a + b)
+        if not min(a, b) < x < max(a, b):
+            x = 0.5 * (a + b)
+        fx = residual(x)
+        if (fx < 0.0) == (rb < 0.0):
+            b, fb, rb = x, fx, fx
+            if side == -1:
+                fa *= 0.5
+            side = -1
+        else:
+            a, fa, ra = x, fx, fx
+            if side == 1:
+                fb *= 0.5
+            side = 1
+        if abs(b - a) <= 0.5 * width:
+            width = abs(b - a)
+            since_halved = 0
+        else:
+            since_halved += 1
+    return (a, ra) if abs(ra) <= abs(rb) else (b, rb)
 
 
 def _columns(outputs: list[StepOutput]) -> dict[str, np.ndarray]:
@@ -949,9 +1017,15 @@ class ContactSimulator:
 
     def _move(self, time: float, depth: float, *, unstable: bool) -> StepOutput:
         """Advance the model from the current state to (time, depth) and publish the output."""
+        return self._publish(time, depth, self._trial(time, depth), unstable=unstable)
+
+    def _publish(
+        self, time: float, depth: float, result: tuple[float, float, float], *, unstable: bool
+    ) -> StepOutput:
+        """Take the model's trial `result` (radius, force, work) at (time, depth) as the step."""
         dt = time - self._time
         r0 = self._output.contact_radius
-        radius, force, work = self._trial(time, depth)
+        radius, force, work = result
         self._energy_input += work
         self._time, self._depth = time, depth
         self._output = self._make_output(time, depth, force, r0, radius, dt, unstable)
@@ -1023,21 +1097,32 @@ class ContactSimulator:
         tol = self.numerics.force_tolerance * max(abs(target), abs(self._output.force), 1e-300)
         was_in_contact = self.in_contact
 
+        model = self._model
+        last: list[Any] = [None, None]  # depth of the last trial and its (radius, force, work)
+
         def residual(depth: float) -> float:
-            self._model.set_state(start.model_state)
-            return self._trial(time, depth)[1] - target
+            model.rewind(start.model_state)
+            result = self._trial(time, depth)
+            last[0], last[1] = depth, result
+            return result[1] - target
 
         r_hold = residual(d0)
         if abs(r_hold) <= tol:
-            self.restore(start)
-            return self._move(time, d0, unstable=False)
+            return self._publish(time, d0, last[1], unstable=False)
         direction = 1.0 if r_hold < 0.0 else -1.0
         if direction < 0.0 and not self._attached() and not was_in_contact:
             # Out of contact and pulled away: no equilibrium, the indenter stays off.
-            self.restore(start)
-            return self._move(time, d0, unstable=target < 0.0)
-        delta = max(abs(r_hold) / self._stiffness_guess(), 1e-12 * (abs(d0) + 1e-12))
-        lo = d0
+            return self._publish(time, d0, last[1], unstable=target < 0.0)
+        # First bracketing step: the Newton step on the contact's instantaneous (glass)
+        # stiffness 2 E0* a, the stiffest the contact can answer, so the step falls short of
+        # the root rather than past it and the doubling below reaches the root nearest the
+        # previous depth first (the 0.1.0 lesson near the fold). Out of contact: the old
+        # relaxed-stiffness scale.
+        stiffness = self._stiffness_guess()
+        if self._output.contact_radius > 0.0:
+            stiffness *= self.physics.e0 / self.physics.e_relaxed
+        delta = max(abs(r_hold) / stiffness, 1e-12 * (abs(d0) + 1e-12))
+        lo, r_lo = d0, r_hold
         last_contact = d0
         for _ in range(200):
             hi = lo + direction * delta
@@ -1051,26 +1136,20 @@ class ContactSimulator:
                 hi, r_hi = found
                 break
             last_contact = hi
-            lo = hi
+            lo, r_lo = hi, r_hi
             delta *= 2.0
         else:
             self.restore(start)
             raise InputError(f"force {target!r} N cannot be reached from depth {d0!r} m")
-        root = brentq(
-            residual,
-            min(lo, hi),
-            max(lo, hi),
-            xtol=1e-15 * max(abs(lo), abs(hi), 1e-300),
-            rtol=1e-15,
-            maxiter=200,
-        )
-        r_root = residual(root)
+        root, r_root = _bracketed_root(residual, lo, r_lo, hi, r_hi, 0.5 * tol)
+        if last[0] != root:
+            r_root = residual(root)
         jumped_in = not was_in_contact and self._attached() and self.physics.work_of_adhesion > 0.0
         # A residual left at the root means the force jumped across the target (snap-in or
         # a discontinuous edge): no continuous equilibrium path; keep the state reached.
         unstable = abs(r_root) > max(tol, 1e-9 * abs(target)) or jumped_in
-        self.restore(start)
-        return self._move(time, root, unstable=unstable)
+        # The model is in the state of the trial at the root: publish it (no second trial).
+        return self._publish(time, root, last[1], unstable=unstable)
 
     def _search_dip(self, residual, detached: float, attached: float) -> tuple[float, float] | None:
         """Between an attached and a detached trial depth, look for a force below the target
