@@ -914,6 +914,7 @@ def _advance(
     motion = MOTION_NONE
     substeps = 0
     attempts = 0
+    jumped_before = False
     if dt <= 0.0:
         new_a, motion, grow = _locate_edge(
             a, d1, wsum, bsum, dx, g_c, gf, gmin, gmax, df, c_crit, reach, math.inf
@@ -1029,11 +1030,14 @@ def _advance(
         a = new_a
         tau += h
         substeps += 1
-        # After a jump (a substep at the shortest length that still moved the edge more than
-        # the limit: snap-in or the fold) try the whole rest of the step at once instead of
-        # doubling back up from 1e-7 dt (about 23 more substeps); the halving catches an edge
-        # that keeps moving fast.
-        step = dt if jumped else 2.0 * h
+        # After an isolated jump (a substep at the shortest length that still moved the edge
+        # more than the limit: snap-in or the fold) try the whole rest of the step at once
+        # instead of doubling back up from the jump's substep (about 13 more substeps); the
+        # halving catches an edge that keeps moving fast. An edge that jumps again right
+        # after (racing across many cells) doubles back up as before: restarting from the
+        # whole rest after every such substep would halve all the way down each time.
+        step = dt if jumped and not jumped_before else 2.0 * h
+        jumped_before = jumped
         if max_substep > 0.0 and step > max_substep:
             step = max_substep
     out[OUT_RADIUS] = a
@@ -1606,6 +1610,10 @@ def warm_up() -> None:
     advance(row, 0.0, 0.0, 0.1, 0.01, max_substep=0.0, max_edge_move=0.25)
     advance(row, 0.3, 0.1, 0.2, 0.0, max_substep=0.0, max_edge_move=0.25)
     force(row, 0.3, 0.1)
+    # The simulator's transaction journal and force-search restores call these from Python.
+    _copy_state(row.wl, row.wb, row.txn, row.txn_b)
+    _restore_state(row.wl, row.wsum, row.wb, row.bsum, row.txn, row.txn_b)
+    _g_at(0.3, row.gf, row.df)
     stored_energy(row, 0.3, 0.1)
     criterion_gap(row, 0.3, 0.1, 0.3, interior=True)
     memory_at(row, 0.3, 0.3, interior=True)

@@ -1094,7 +1094,12 @@ class ContactSimulator:
         """Find the depth whose step from the current state gives `target` force (N)."""
         start = self.snapshot()
         d0 = self._depth
-        tol = self.numerics.force_tolerance * max(abs(target), abs(self._output.force), 1e-300)
+        # Relative to the larger of the commanded force, the last force and the contact's
+        # adhesive force scale 2 E0* a dl_c(a) (the JKR adhesive term at the current radius):
+        # a zero force commanded to a contact in adhesive equilibrium is not asked to 1e-300 N.
+        radius = self._output.contact_radius
+        adhesive = 2.0 * self.physics.e0 * radius * self.physics.c_crit * math.sqrt(radius)
+        tol = self.numerics.force_tolerance * max(abs(target), abs(self._output.force), adhesive, 1e-300)
         was_in_contact = self.in_contact
 
         model = self._model
@@ -1169,17 +1174,28 @@ class ContactSimulator:
         # Golden-section on the attached interval for the force minimum.
         a, b = hi, attached
         golden = 0.5 * (math.sqrt(5.0) - 1.0)
-        for _ in range(60):
-            c = b - golden * (b - a)
-            d = a + golden * (b - a)
-            rc, rd = residual(c), residual(d)
-            for x, r in ((c, rc), (d, rd)):
-                if r <= 0.0:
-                    return x, r
+        c = b - golden * (b - a)
+        d = a + golden * (b - a)
+        rc = residual(c)
+        if rc <= 0.0:
+            return c, rc
+        rd = residual(d)
+        if rd <= 0.0:
+            return d, rd
+        # One new trial per iteration: the interior point that stays is reused.
+        for _ in range(120):
             if rc < rd:
-                b = d
+                b, d, rd = d, c, rc
+                c = b - golden * (b - a)
+                rc = residual(c)
+                if rc <= 0.0:
+                    return c, rc
             else:
-                a = c
+                a, c, rc = c, d, rd
+                d = a + golden * (b - a)
+                rd = residual(d)
+                if rd <= 0.0:
+                    return d, rd
             if abs(b - a) <= 1e-10 * max(abs(a), abs(b), 1e-300):
                 break
         return None
