@@ -1357,11 +1357,19 @@ class Row:
         self.gmin = np.minimum.reduceat(gf, np.arange(0, m, TOUCH_BLOCK))
         self.gmax = np.maximum.reduceat(gf, np.arange(0, m, TOUCH_BLOCK))
         self.out = np.zeros(OUT_SIZE)
+        self._kernel_args: tuple | None = None
 
     @property
     def kernel_args(self) -> tuple:
         """The row's arrays and constants in the order `_advance` takes them (before the
-        step's scalars); the benchmark calls the kernel with the same tuple."""
+        step's scalars); the benchmark calls the kernel with the same tuple. Built once per
+        row (the arrays are only ever written in place)."""
+        args = self._kernel_args
+        if args is None:
+            args = self._kernel_args = self._build_kernel_args()
+        return args
+
+    def _build_kernel_args(self) -> tuple:
         return (
             self.wl,
             self.wsum,
@@ -1418,6 +1426,7 @@ class Row:
         clone.txn_b = np.empty_like(self.txn_b)
         clone.diss = np.zeros_like(self.diss)
         clone.out = np.zeros(OUT_SIZE)
+        clone._kernel_args = None
         clone.set_memory(wl, wb)
         return clone
 

@@ -1009,7 +1009,7 @@ class ContactSimulator:
     def _trial(self, time: float, depth: float) -> tuple[float, float, float]:
         """Advance the model (only) from the current state to (time, depth); returns
         (radius m, force N, work J). An idle contact above the surface costs nothing."""
-        if self.is_idle and depth < 0.0 and self._depth < 0.0:
+        if depth < 0.0 and self._depth < 0.0 and self.is_idle:
             if isinstance(self._model, _TimeStepped):
                 self._model.drop_memory()
             return 0.0, 0.0, 0.0
