@@ -1094,12 +1094,14 @@ class ContactSimulator:
         """Find the depth whose step from the current state gives `target` force (N)."""
         start = self.snapshot()
         d0 = self._depth
-        # Relative to the larger of the commanded force, the last force and the contact's
-        # adhesive force scale 2 E0* a dl_c(a) (the JKR adhesive term at the current radius):
-        # a zero force commanded to a contact in adhesive equilibrium is not asked to 1e-300 N.
+        tol = self.numerics.force_tolerance * max(abs(target), abs(self._output.force), 1e-300)
+        # The root search stops within half the tolerance relative to the commanded force,
+        # floored at 1e-6 of the contact's adhesive force scale 2 E0* a dl_c(a) (the JKR
+        # adhesive term at the current radius): a zero force commanded to a contact in
+        # adhesive equilibrium is not chased down to 1e-300 N (44 trials per step).
         radius = self._output.contact_radius
         adhesive = 2.0 * self.physics.e0 * radius * self.physics.c_crit * math.sqrt(radius)
-        tol = self.numerics.force_tolerance * max(abs(target), abs(self._output.force), adhesive, 1e-300)
+        stop = 0.5 * self.numerics.force_tolerance * max(abs(target), 1e-6 * adhesive, 1e-300)
         was_in_contact = self.in_contact
 
         model = self._model
@@ -1146,7 +1148,7 @@ class ContactSimulator:
         else:
             self.restore(start)
             raise InputError(f"force {target!r} N cannot be reached from depth {d0!r} m")
-        root, r_root = _bracketed_root(residual, lo, r_lo, hi, r_hi, 0.5 * tol)
+        root, r_root = _bracketed_root(residual, lo, r_lo, hi, r_hi, stop)
         if last[0] != root:
             r_root = residual(root)
         jumped_in = not was_in_contact and self._attached() and self.physics.work_of_adhesion > 0.0
