@@ -11,10 +11,11 @@ from typing import Any
 import numpy as np
 import pytest
 
-from viscoadh_ros.bench import accuracy, kernel, report, suite
+from viscoadh_ros.bench import accuracy, kernel, reference_stepper, report, suite
 from viscoadh_ros.bench.latency import measure_round_trips, summarize_node_latency
 from viscoadh_ros.bench.timing import interleaved_medians, latency_summary
 from viscoadh_ros.cli.main import main as cli_main
+from viscoadh_ros.core.simulator import ContactSimulator
 
 TINY = dataclasses.replace(
     suite.QUICK,
@@ -79,13 +80,54 @@ def test_kernel_row_is_well_formed(kelvin: int) -> None:
     assert row["elements"] == 32 and row["kelvin"] == kelvin
     assert_finite_numbers(row, f"K={kelvin}")
     assert row["ns_per_element_step"] > 0 and row["baseline_ns_per_element_step"] > 0
-    np.testing.assert_allclose(
-        row["ratio"],
-        row["ns_per_element_step"] / row["baseline_ns_per_element_step"],
-        rtol=1e-12,
-        err_msg=f"ratio of K={kelvin}",
-    )
+    for ratio, over, under in (
+        ("ratio", "ns_per_element_step", "baseline_ns_per_element_step"),
+        ("python_ratio", "step_us", "minimal_step_us"),
+        ("batch_ratio", "batch_us", "minimal_run_us"),
+    ):
+        np.testing.assert_allclose(
+            row[ratio], row[over] / row[under], rtol=1e-12, err_msg=f"{ratio} of K={kelvin}"
+        )
     assert row["substeps_per_step"] >= 1.0
+    # The minimal stepper computes the same model: its pull-off within a few percent even at
+    # 32 elements (a baseline that computed something else would show here).
+    assert row["pull_off_rel_diff"] < 0.05, row
+    assert row["max_force_diff_rel"] < 0.2, row
+
+
+def test_minimal_stepper_agrees_with_the_product_on_a_pull_off() -> None:
+    """The bench's baseline is a stepper of the same model: on the product's own grid, its
+    force along a press and pull-off from rest follows the product's (jump rows excluded)."""
+    case = next(c for c in accuracy.cases() if c.name == "standard_solid_pull_off")
+    contact = accuracy.contact_config(case, {"elements": 128, "model": "time_stepped", "domain_radius": 1e-3})
+    sim = ContactSimulator(contact)
+    row = sim._model._build_row(1e-3, None)
+    model = sim._model
+    minimal = reference_stepper.MinimalStepper(
+        g_centres=row.g_c,
+        dx=row.dx,
+        e0=sim.physics.e0,
+        e_kelvin=model.e_kelvin,
+        eta_kelvin=model.e_kelvin / model.rate,
+        c_crit=sim.physics.c_crit,
+    )
+    agreement = kernel._agreement(contact, row, minimal, case.depth_scale)
+    assert agreement["pull_off_rel_diff"] < 0.01, agreement
+    assert agreement["max_force_diff_rel"] < 0.05, agreement
+
+
+def test_step_costs_names_the_jump_rows_and_the_ratios() -> None:
+    costs = kernel.step_costs(repeats=1, seconds=1.0)
+    assert_finite_numbers(costs, "step costs")
+    assert 0 < costs["snap_in_row"] < costs["pull_off_row"] < costs["rows"] == 1000
+    for name in ("depth", "force"):
+        assert 0 < costs[f"{name}_median_us"] <= costs[f"{name}_p99_us"] <= costs[f"{name}_max_us"]
+        np.testing.assert_allclose(
+            costs[f"{name}_max_over_median"], costs[f"{name}_max_us"] / costs[f"{name}_median_us"], rtol=1e-12
+        )
+    np.testing.assert_allclose(
+        costs["force_mean_ratio"], costs["force_mean_us"] / costs["depth_mean_us"], rtol=1e-12
+    )
 
 
 def test_accuracy_cases_use_the_closed_forms() -> None:

@@ -1,18 +1,27 @@
-"""Cost of the simulator's compiled step against the physical floor of this machine.
+"""Cost of the simulator's step against a minimal stepper of the same model (issue 13).
 
-The floor is a bare compiled loop that reads and writes the same state arrays as the kernel
-(the Kelvin elongations `wl` (N, K) and their sums `wsum` (N,), with the profile `g_c` (N,))
-once per step and does nothing else. The kernel is `core._kernels._advance` on a row built by
-`ContactSimulator` itself for a standard-solid sphere, driven through a 1 kHz depth cycle that
-keeps the contact open and its edge moving. Both run as compiled loops over the steps, so the
-numbers compare the kernels and not Python's call overhead; the whole `ContactSimulator.step`
-(Python included) is reported beside them as `step_us`.
+Per element count N and Kelvin count K, on a standard-solid sphere driven through a 1 kHz
+depth cycle that keeps the contact open and its edge moving, side by side in one run:
+
+- the product's compiled kernel (`core._kernels._advance` on the row `ContactSimulator`
+  built, looped in numba), `step_depths` per row, and `ContactSimulator.step` per call;
+- `bench.reference_stepper.MinimalStepper` on the same grid from the same state, as one
+  compiled run (`run`) and per call (`step`): the smallest correct program of the model, the
+  baseline of the 2x target; its agreement with the product (pull-off and branch forces
+  relative to the pull-off force, jump rows excluded) is stated beside its time;
+- a bare compiled loop that only reads and writes the state arrays once per step: the
+  memory floor no stepper reaches.
+
+`step_costs` measures the other target: every step bounded (snap-in and pull-off rows
+against the median step of the scene) and force control against depth control.
 """
 
 from __future__ import annotations
 
 import math
+import time
 from collections.abc import Sequence
+from dataclasses import replace
 from typing import Any
 
 import numba
@@ -20,8 +29,10 @@ import numpy as np
 import numpy.typing as npt
 
 from viscoadh_ros.bench.accuracy import Case, cases, contact_config
-from viscoadh_ros.bench.timing import interleaved_medians, median_seconds
+from viscoadh_ros.bench.reference_stepper import MinimalStepper
+from viscoadh_ros.bench.timing import interleaved_medians
 from viscoadh_ros.core import _kernels
+from viscoadh_ros.core.config import SceneConfig, default_scene_path
 from viscoadh_ros.core.simulator import ContactSimulator
 
 STEP_S = 1e-3  # the node's command period at 1 kHz
@@ -29,6 +40,8 @@ STEP_TIMING_STEPS = 100
 CYCLE_S = 2.0  # slow enough that the edge crosses about one element per step at 4096 elements
 # The depth cycles between these multiples of the case's JKR depth scale: always in contact.
 DEPTH_LOW, DEPTH_HIGH = 0.5, 2.0
+#: Rows of the pull-off run that states the minimal stepper's agreement with the product.
+AGREEMENT_ROWS = 400
 
 
 @numba.njit(cache=True)
@@ -88,17 +101,51 @@ def _cycle(case: Case, steps: int) -> npt.NDArray[np.float64]:
     return case.depth_scale * (DEPTH_LOW + (DEPTH_HIGH - DEPTH_LOW) * phase)
 
 
+def _agreement(contact: Any, row: _kernels.Row, minimal: MinimalStepper, scale: float) -> dict[str, float]:
+    """How far the minimal stepper is from the product on one press and pull-off from rest
+    (to the cycle's deepest point and out past pull-off, 1 kHz rows), the product on the same
+    fixed grid (`numerics.domain_radius` = the row's length): the pull-off (most tensile
+    force) relative difference, and the largest force difference relative to the product's
+    pull-off force over the rows where neither jumps (both in contact or both out, and
+    neither edge moved more than two elements in the row)."""
+    numerics = replace(contact.numerics, domain_radius=row.length, elements=row.elements)
+    product_sim = ContactSimulator(replace(contact, numerics=numerics))
+    depths = scale * np.concatenate(
+        [
+            np.linspace(0.0, DEPTH_HIGH, AGREEMENT_ROWS // 4 + 1)[1:],
+            np.linspace(DEPTH_HIGH, -2.0, AGREEMENT_ROWS)[1:],
+        ]
+    )
+    times = STEP_S * np.arange(1, depths.size + 1)
+    product = product_sim.step_depths(times, depths)
+    minimal.set_state(depth=0.0, radius=0.0, memory=np.zeros_like(row.wl))
+    radius_min = np.empty(depths.size)
+    force_min = np.empty(depths.size)
+    for index, d in enumerate(depths):
+        force_min[index] = minimal.step(STEP_S, float(d))
+        radius_min[index] = minimal.radius
+    pull_off = float(np.min(product["force"]))
+    r_p = np.concatenate(([0.0], product["contact_radius"]))
+    r_m = np.concatenate(([0.0], radius_min))
+    steady = (
+        ((r_p[1:] > 0.0) == (r_m[1:] > 0.0))
+        & (np.abs(np.diff(r_p)) <= 2.0 * row.dx)
+        & (np.abs(np.diff(r_m)) <= 2.0 * row.dx)
+    )
+    diff = np.abs(product["force"] - force_min)[steady]
+    return {
+        "pull_off_rel_diff": abs(float(np.min(force_min)) - pull_off) / abs(pull_off),
+        "max_force_diff_rel": float(np.max(diff, initial=0.0)) / abs(pull_off),
+    }
+
+
 def measure_kernel(elements: int, kelvin: int, *, steps: int, repeats: int) -> dict[str, Any]:
     """One row of the `kernel` results section (see the module docstring)."""
     case = next(c for c in cases() if c.name == "standard_solid_pull_off")
+    material = kelvin_material(case, kelvin)
     contact = contact_config(
-        Case(
-            case.name,
-            dict(case.contact, material=kelvin_material(case, kelvin)),
-            case.cycle_time,
-            case.closed_form,
-        ),
-        {"elements": elements},
+        Case(case.name, dict(case.contact, material=material), case.cycle_time, case.closed_form),
+        {"elements": elements, "model": "time_stepped"},
     )
     depth = _cycle(case, steps)
     simulator = ContactSimulator(contact)
@@ -113,6 +160,16 @@ def measure_kernel(elements: int, kelvin: int, *, steps: int, repeats: int) -> d
     radius = model.radius
     numerics = simulator.numerics
     wl0, wb0 = row.memory()
+    d_start = simulator.output.depth
+    # The minimal stepper on the product's own grid, from the product's own state.
+    minimal = MinimalStepper(
+        g_centres=row.g_c,
+        dx=row.dx,
+        e0=simulator.physics.e0,
+        e_kelvin=model.e_kelvin,
+        eta_kelvin=model.e_kelvin / model.rate if model.e_kelvin.size else np.zeros(0),
+        c_crit=simulator.physics.c_crit,
+    )
 
     max_substep = float(numerics.max_substep)
     max_edge_move = float(numerics.max_edge_cells * row.dx)
@@ -124,34 +181,70 @@ def measure_kernel(elements: int, kelvin: int, *, steps: int, repeats: int) -> d
     def run_bare() -> None:
         _bare_steps(row.wl, row.wsum, row.g_c, depth)
 
+    def run_minimal() -> None:
+        minimal.set_state(depth=d_start, radius=radius, memory=wl0)
+        minimal.run(STEP_S, depth[1:])
+
+    t0 = simulator.time
+    batch_times = t0 + STEP_S * np.arange(1, steps + 1)
+
+    def run_batch() -> None:
+        simulator.restore(start)
+        simulator.step_depths(batch_times, depth[1:])
+
+    minimal.step(STEP_S, float(depth[0]))  # compiles the per-call entry point
     substeps = run_kernel()  # compiles (or loads the cache) outside the timing
     if substeps < 0:
         raise RuntimeError(f"kernel benchmark: the contact outgrew its domain at {elements} elements")
     run_bare()
-    times = interleaved_medians({"kernel": run_kernel, "bare": run_bare}, repeats=repeats)
+    run_minimal()
+    run_batch()
+    times = interleaved_medians(
+        {"kernel": run_kernel, "bare": run_bare, "minimal": run_minimal, "batch": run_batch}, repeats=repeats
+    )
 
-    # The whole Python step (validation, kernel, outputs) on a shorter stretch of the same cycle:
-    # it costs far more than the kernel, and its per-step cost is what a node pays.
+    # Per call from Python, side by side: the whole `ContactSimulator.step` and the minimal
+    # stepper's `step`, on a shorter stretch of the same cycle.
     step_count = min(steps, STEP_TIMING_STEPS)
-    t0 = simulator.time
 
     def run_steps() -> None:
         simulator.restore(start)
         for index in range(1, step_count + 1):
             simulator.step(t0 + index * STEP_S, depth=float(depth[index]))
 
-    step_s = median_seconds(run_steps, repeats=max(1, repeats // 2))
+    def run_minimal_steps() -> None:
+        minimal.set_state(depth=d_start, radius=radius, memory=wl0)
+        for index in range(1, step_count + 1):
+            minimal.step(STEP_S, float(depth[index]))
+
+    calls = interleaved_medians(
+        {"step": run_steps, "minimal_step": run_minimal_steps}, repeats=max(1, repeats // 2)
+    )
+    agreement = _agreement(contact, row, minimal, case.depth_scale)
     element_steps = row.elements * steps
     kernel_ns = times["kernel"] / element_steps * 1e9
     bare_ns = times["bare"] / element_steps * 1e9
+    minimal_ns = times["minimal"] / element_steps * 1e9
+    step_us = calls["step"] / step_count * 1e6
+    minimal_step_us = calls["minimal_step"] / step_count * 1e6
+    batch_us = times["batch"] / steps * 1e6
+    minimal_run_us = times["minimal"] / steps * 1e6
     return {
         "elements": row.elements,
         "kelvin": kelvin,
         "ns_per_element_step": kernel_ns,
         "baseline_ns_per_element_step": bare_ns,
         "ratio": kernel_ns / bare_ns,
+        "minimal_ns_per_element_step": minimal_ns,
+        "kernel_vs_minimal": kernel_ns / minimal_ns,
         "substeps_per_step": substeps / steps,
-        "step_us": step_s / step_count * 1e6,
+        "step_us": step_us,
+        "minimal_step_us": minimal_step_us,
+        "python_ratio": step_us / minimal_step_us,
+        "batch_us": batch_us,
+        "minimal_run_us": minimal_run_us,
+        "batch_ratio": batch_us / minimal_run_us,
+        **agreement,
     }
 
 
@@ -160,3 +253,66 @@ def kernel_table(
 ) -> list[dict[str, Any]]:
     """The `kernel` results section: every element count at every Kelvin count."""
     return [measure_kernel(n, k, steps=steps, repeats=repeats) for k in kelvin for n in elements]
+
+
+#: The bounded-step scene: the built-in default contact (balanced) pressed and pulled off
+#: along a sine (snap-in, sticking, pull-off, out of contact with memory left) at 1 kHz.
+SCENE_SECONDS = 3.0
+SCENE_AMPLITUDE = 80e-6
+SCENE_OFFSET = -10e-6
+
+
+def _scene_history(seconds: float) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+    t = STEP_S * np.arange(1, int(round(seconds / STEP_S)) + 1)
+    return t, SCENE_AMPLITUDE * np.sin(2.0 * math.pi * t / seconds) + SCENE_OFFSET
+
+
+def _per_step(simulator: ContactSimulator, times, values, key: str) -> npt.NDArray[np.float64]:
+    """Wall time of each `step` call, s."""
+    cost = np.empty(times.size)
+    clock = time.perf_counter
+    for index in range(times.size):
+        start = clock()
+        simulator.step(float(times[index]), **{key: float(values[index])})
+        cost[index] = clock() - start
+    return cost
+
+
+def step_costs(*, repeats: int, seconds: float = SCENE_SECONDS) -> dict[str, Any]:
+    """Every step bounded (issue 13): the per-step cost distribution of `step` on the default
+    scene under depth control (the sine above, snap-in and pull-off included) and under force
+    control (the forces the depth run produced, commanded back), per step the median over
+    `repeats` runs (the sine's period is `seconds`); the snap-in and pull-off rows named."""
+    contact = SceneConfig.from_yaml(default_scene_path()).contacts[0]
+    times, depths = _scene_history(seconds)
+    depth_runs, force_runs = [], []
+    forces = radius = None
+    for _ in range(repeats + 1):  # the first run loads the kernels
+        simulator = ContactSimulator(contact)
+        depth_runs.append(_per_step(simulator, times, depths, "depth"))
+        if forces is None:
+            reference = ContactSimulator(contact).step_depths(times, depths)
+            forces, radius = reference["force"], reference["contact_radius"]
+        force_runs.append(_per_step(ContactSimulator(contact), times, forces, "force"))
+    depth_cost = np.median(np.array(depth_runs[1:]), axis=0)
+    force_cost = np.median(np.array(force_runs[1:]), axis=0)
+    assert radius is not None
+    snap_in = int(np.flatnonzero(radius > 0.0)[0])
+    pull_off = int(np.flatnonzero((radius[:-1] > 0.0) & (radius[1:] <= 0.0))[0]) + 1
+    summary: dict[str, Any] = {"rows": int(times.size), "snap_in_row": snap_in, "pull_off_row": pull_off}
+    for name, cost in (("depth", depth_cost), ("force", force_cost)):
+        median = float(np.median(cost))
+        summary.update(
+            {
+                f"{name}_median_us": median * 1e6,
+                f"{name}_mean_us": float(np.mean(cost)) * 1e6,
+                f"{name}_p99_us": float(np.percentile(cost, 99.0)) * 1e6,
+                f"{name}_max_us": float(np.max(cost)) * 1e6,
+                f"{name}_max_over_median": float(np.max(cost)) / median,
+            }
+        )
+    summary["snap_in_us"] = float(depth_cost[snap_in]) * 1e6
+    summary["pull_off_us"] = float(depth_cost[pull_off]) * 1e6
+    summary["force_mean_ratio"] = summary["force_mean_us"] / summary["depth_mean_us"]
+    summary["force_p99_ratio"] = summary["force_p99_us"] / summary["depth_p99_us"]
+    return summary

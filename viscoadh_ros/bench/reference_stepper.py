@@ -8,7 +8,7 @@ beside its time, so a fast baseline that computes something else is seen at once
 
 The algorithm (one contact, displacement control, depth linear in time over each step):
 - N elements at centres ``x_i = (i + 1/2) dx``; the Kelvin elongations are stored mode by mode
-  (structure of arrays, ``l[k, i]``) with their sum ``w[i]``;
+  (structure of arrays, ``kel[k, i]``) with their sum ``w[i]``;
 - the Kelvin chain of an element in contact is updated exactly for a linearly varying input
   (first-order hold) in the chain's modal form (``z = P l``, ``dz/dt = -lam z + beta u``); out of
   contact each Kelvin element creeps back with ``exp(-G_k dt / eta_k)``;
@@ -56,27 +56,29 @@ def _coefficients(lam, dt, out):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
-def _in_contact(l, w, i, u0, u1, p, p_inv, beta, coef, z):  # pragma: no cover - compiled
-    k_count = l.shape[0]
+def _in_contact(kel, w, i, u0, u1, p, p_inv, beta, coef, z):  # pragma: no cover - compiled
+    k_count = kel.shape[0]
     for m in range(k_count):
         acc = 0.0
         for k in range(k_count):
-            acc += p[m, k] * l[k, i]
+            acc += p[m, k] * kel[k, i]
         z[m] = coef[0, m] * acc + beta[m] * (u0 * coef[1, m] + (u1 - u0) * coef[2, m])
     total = 0.0
     for k in range(k_count):
         acc = 0.0
         for m in range(k_count):
             acc += p_inv[k, m] * z[m]
-        l[k, i] = acc
+        kel[k, i] = acc
         total += acc
     w[i] = total
 
 
 @numba.njit(cache=True, nogil=True)
-def _step(l, old, w, g, crit, dx, e0, p, p_inv, lam, beta, rate, coef, z, state, dt, d1):  # pragma: no cover
+def _step(
+    kel, old, w, g, crit, dx, e0, p, p_inv, lam, beta, rate, coef, z, state, dt, d1
+):  # pragma: no cover
     """One step to depth d1 over dt; returns the force, N (state updated in place)."""
-    k_count, n = l.shape
+    k_count, n = kel.shape
     a0 = state[_RADIUS]
     d0 = state[_DEPTH]
     n0 = int(state[_COUNT])
@@ -85,14 +87,14 @@ def _step(l, old, w, g, crit, dx, e0, p, p_inv, lam, beta, rate, coef, z, state,
         coef[3, k] = math.exp(-rate[k] * dt)
     for i in range(n0):
         for k in range(k_count):
-            old[k, i] = l[k, i]
-        _in_contact(l, w, i, d0 - g[i], d1 - g[i], p, p_inv, beta, coef, z)
+            old[k, i] = kel[k, i]
+        _in_contact(kel, w, i, d0 - g[i], d1 - g[i], p, p_inv, beta, coef, z)
     for i in range(n0, n):
         total = 0.0
         for k in range(k_count):
-            old[k, i] = l[k, i]
-            value = l[k, i] * coef[3, k]
-            l[k, i] = value
+            old[k, i] = kel[k, i]
+            value = kel[k, i] * coef[3, k]
+            kel[k, i] = value
             total += value
         w[i] = total
     # The edge from the criterion at the centres: detachment first, else attachment.
@@ -126,19 +128,19 @@ def _step(l, old, w, g, crit, dx, e0, p, p_inv, lam, beta, rate, coef, z, state,
             f = min(max(f, 0.0), 1.0)
             d_switch = d0 + f * (d1 - d0)
             for k in range(k_count):
-                l[k, i] = old[k, i]
+                kel[k, i] = old[k, i]
             if n1 > n0:
                 for k in range(k_count):
-                    l[k, i] *= math.exp(-rate[k] * f * dt)
+                    kel[k, i] *= math.exp(-rate[k] * f * dt)
                 _coefficients(lam, (1.0 - f) * dt, coef)
-                _in_contact(l, w, i, d_switch - g[i], d1 - g[i], p, p_inv, beta, coef, z)
+                _in_contact(kel, w, i, d_switch - g[i], d1 - g[i], p, p_inv, beta, coef, z)
             else:
                 _coefficients(lam, f * dt, coef)
-                _in_contact(l, w, i, d0 - g[i], d_switch - g[i], p, p_inv, beta, coef, z)
+                _in_contact(kel, w, i, d0 - g[i], d_switch - g[i], p, p_inv, beta, coef, z)
                 total = 0.0
                 for k in range(k_count):
-                    value = l[k, i] * math.exp(-rate[k] * (1.0 - f) * dt)
-                    l[k, i] = value
+                    value = kel[k, i] * math.exp(-rate[k] * (1.0 - f) * dt)
+                    kel[k, i] = value
                     total += value
                 w[i] = total
     force = 0.0
@@ -156,10 +158,14 @@ def _step(l, old, w, g, crit, dx, e0, p, p_inv, lam, beta, rate, coef, z, state,
 
 
 @numba.njit(cache=True, nogil=True)
-def _run(l, old, w, g, crit, dx, e0, p, p_inv, lam, beta, rate, coef, z, state, dt, depths, forces):  # pragma: no cover
+def _run(
+    kel, old, w, g, crit, dx, e0, p, p_inv, lam, beta, rate, coef, z, state, dt, depths, forces
+):  # pragma: no cover
     """_step over a depth history at a fixed dt, forces written to `forces`."""
     for s in range(depths.shape[0]):
-        forces[s] = _step(l, old, w, g, crit, dx, e0, p, p_inv, lam, beta, rate, coef, z, state, dt, depths[s])
+        forces[s] = _step(
+            kel, old, w, g, crit, dx, e0, p, p_inv, lam, beta, rate, coef, z, state, dt, depths[s]
+        )
 
 
 class MinimalStepper:

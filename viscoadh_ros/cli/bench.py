@@ -94,14 +94,20 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def _summary(results: dict) -> str:
     lines = []
     if "kernel" in results:
-        worst = max(
-            (k for k in results["kernel"] if k["elements"] >= 256), key=lambda k: k["ratio"], default=None
+        for key, what in (("python_ratio", "step() per call"), ("batch_ratio", "step_depths")):
+            rows = [k for k in results["kernel"] if key in k]
+            worst = max(rows, key=lambda k: k[key], default=None)
+            if worst is not None:
+                lines.append(
+                    f"kernel: worst {what} / minimal stepper {worst[key]:.3g} "
+                    f"({worst['elements']} elements, K={worst['kelvin']})"
+                )
+    if "step_costs" in results:
+        costs = results["step_costs"]
+        lines.append(
+            f"steps: largest / median {costs['depth_max_over_median']:.3g} (depth control); "
+            f"force / depth control mean {costs['force_mean_ratio']:.3g}, p99 {costs['force_p99_ratio']:.3g}"
         )
-        if worst is not None:
-            lines.append(
-                f"kernel: worst ratio to the bare loop at >= 256 elements {worst['ratio']:.3g} "
-                f"({worst['elements']} elements, K={worst['kelvin']})"
-            )
     for preset in results.get("presets", []):
         lines.append(
             f"preset {preset['preset']:>8} {preset['case']:<24} error {preset['rel_error']:.3g} "

@@ -90,6 +90,16 @@ class StepOutput:
 
 STEP_OUTPUT_FIELDS = tuple(f.name for f in fields(StepOutput))
 
+
+def _new_output(*values: Any) -> StepOutput:
+    """A StepOutput from its field values in order, without the frozen dataclass's
+    ``__init__`` (one ``object.__setattr__`` per field, the larger part of a step's Python
+    cost): the instance is the same (same fields, equality, hash, repr)."""
+    output = object.__new__(StepOutput)
+    output.__dict__.update(zip(STEP_OUTPUT_FIELDS, values, strict=True))
+    return output
+
+
 #: Largest flank slope f'(a) at the contact edge for which the half-space (small-slope) theory
 #: behind MDR is taken as valid: its neglected terms grow like the slope squared (a sphere at
 #: a/R = 0.3 is Hertz within a few percent).
@@ -301,8 +311,23 @@ class _ClosedForm:
         gap = self._gap(depth, self.radius)
         return gap, gap
 
+    def edge_height(self, radius: float) -> float:
+        """Profile g at `radius`, m."""
+        return float(self.physics.profile.g(radius))
+
     def is_relaxed(self) -> bool:
         return True
+
+    def begin(self) -> float:
+        """Start a transaction (`ContactSimulator.step`): the token `rollback` takes."""
+        return self.radius
+
+    def rewind(self, state: float) -> None:
+        """`set_state` for a trial of the force search (the state is one of this model's)."""
+        self.radius = state
+
+    def rollback(self, token: float) -> None:
+        self.radius = token
 
     def get_state(self) -> float:
         return self.radius
@@ -342,6 +367,12 @@ class _TimeStepped:
             self.initial_length = 0.0  # chosen from the depth at first contact
         if self.punch_radius is not None:
             self.initial_length = min(self.initial_length, self.punch_radius)
+        # The first contact's domain, built once here (about 0.1 ms: the fine profile grid and
+        # its checks) rather than inside the snap-in step; each new contact takes a copy of
+        # it with zero memory.
+        self._template: _kernels.Row | None = None
+        if self.initial_length > 0.0:
+            self._template = self._build_row(self.initial_length, None)
         self.row: _kernels.Row | None = None
         self.radius = 0.0
         self.substeps = 0
@@ -350,6 +381,12 @@ class _TimeStepped:
         self.dissipated = 0.0
         # Largest |wsum| (m) the last `advance` left, None once the state changed otherwise.
         self._memory_peak: float | None = None
+        # The transaction journal (`begin`/`rollback`): the row whose `txn` buffers hold its
+        # memory from before the transaction's first kernel call, None before that call.
+        self._journal: _kernels.Row | None = None
+        # Edge outputs of the last `advance` (gaps outside/inside, g at the edge) and its depth.
+        self._edge = (0.0, 0.0, 0.0)
+        self._edge_depth = math.nan
 
     # -- the domain ---------------------------------------------------------------------
     def _build_row(
@@ -417,11 +454,12 @@ class _TimeStepped:
             return True
         if depth < 0.0:
             return False
-        length = self.initial_length
-        if length <= 0.0:
-            length = 1.25 * float(self.physics.profile.radius_at_height(depth))
-            if not length > 0.0:
-                return False
+        if self._template is not None:
+            self.row = self._template.with_memory(np.zeros_like(self._template.wl))
+            return True
+        length = 1.25 * float(self.physics.profile.radius_at_height(depth))
+        if not length > 0.0:
+            return False
         self.row = self._build_row(length, None)
         return True
 
@@ -431,7 +469,16 @@ class _TimeStepped:
             self.substeps = 0
             return 0.0, 0.0, 0.0
         assert self.row is not None
-        start = self.get_state()
+        row = self.row
+        if self._journal is not row:
+            # First kernel call of the transaction on this row: journal its memory (compiled
+            # copy into preallocated buffers) instead of a snapshot of numpy copies.
+            _kernels._copy_state(row.wl, row.wb, row.txn, row.txn_b)
+            self._journal = row
+            start = None
+        else:
+            start = self.get_state()
+        radius0, dissipated0 = self.radius, self.dissipated
         while True:
             row = self.row
             # The kernel itself, not the validating wrapper: the row's arrays are checked
@@ -447,22 +494,29 @@ class _TimeStepped:
             )
             if status == _kernels.STATUS_OK:
                 break
-            self.set_state(start)
+            if start is None:
+                _kernels._restore_state(row.wl, row.wsum, row.wb, row.bsum, row.txn, row.txn_b)
+            else:
+                self.set_state(start)
+            self.radius, self.dissipated = radius0, dissipated0
             self._grow(d0)
             start = self.get_state()
-        out = row.out
-        self.radius = float(out[_kernels.OUT_RADIUS])
-        self.substeps = int(out[_kernels.OUT_SUBSTEPS])
-        self.dissipated += float(out[_kernels.OUT_DISSIPATED])
-        self._memory_peak = float(out[_kernels.OUT_MEMORY])
-        return self.radius, float(out[_kernels.OUT_FORCE]), float(out[_kernels.OUT_WORK])
+        radius, force, work, _, substeps, dissipated, peak, outside, inside, g_edge = row.out.tolist()
+        self.radius = radius
+        self.substeps = int(substeps)
+        self.dissipated += dissipated
+        self._memory_peak = peak
+        self._edge = (outside, inside, g_edge)
+        self._edge_depth = d1
+        return radius, force, work
 
     def advance_rows(
         self, sim: ContactSimulator, times: np.ndarray, depths: np.ndarray
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Advance through a depth history from ``sim``'s time and depth as `sim._trial`
         then `advance` would row by row; returns per row (radius m, force N, work J, energy
-        dissipated since the last reset J, edge gaps (n, 2) m: exterior, interior memory).
+        dissipated since the last reset J, edge gaps and g at the edge (n, 3) m: exterior
+        memory, interior memory, profile).
         Rows without a row (no domain yet, or idle above the surface) cost nothing here
         either."""
         n = times.size
@@ -521,7 +575,7 @@ class _TimeStepped:
             out[:, _kernels.OUT_FORCE].copy(),
             out[:, _kernels.OUT_WORK].copy(),
             dissipated,
-            rows[:, _kernels.ROW_GAP_OUTSIDE :].copy(),
+            rows[:, _kernels.OUT_GAP_OUTSIDE : _kernels.OUT_G_EDGE + 1].copy(),
         )
 
     def stored_energy(self, depth: float) -> float:
@@ -538,10 +592,51 @@ class _TimeStepped:
     def edge_gaps(self, depth: float) -> tuple[float, float]:
         """h at the edge with the exterior and with the interior memory, m."""
         assert self.row is not None
+        if depth == self._edge_depth:
+            return self._edge[0], self._edge[1]  # the last advance computed them
         return (
             _kernels.criterion_gap(self.row, self.radius, depth, self.radius, interior=False),
             _kernels.criterion_gap(self.row, self.radius, depth, self.radius, interior=True),
         )
+
+    def edge_height(self, radius: float) -> float:
+        """Profile g at the edge `radius` (m), m, as the kernel sees it (fine grid)."""
+        if radius == self.radius and self._edge_depth == self._edge_depth and radius > 0.0:
+            return self._edge[2]
+        if self.row is None or radius <= 0.0:
+            return float(self.physics.profile.g(radius))
+        return float(_kernels._g_at(radius, self.row.gf, self.row.df))
+
+    def rewind(self, state: tuple) -> None:
+        """Back to `state` (from `get_state` of this model) for the next trial of the force
+        search: the memory copied back in compiled code, without `set_state`'s validation
+        (the arrays are the model's own copies) when the row is still the same."""
+        radius, row, memory, unit, dissipated = state
+        if row is None or row is not self.row:
+            self.set_state(state)
+            return
+        _kernels._restore_state(row.wl, row.wsum, row.wb, row.bsum, memory, unit)
+        self.radius = radius
+        self.dissipated = dissipated
+        self._memory_peak = None
+        self._edge_depth = math.nan
+
+    def begin(self) -> tuple:
+        """Start a transaction (`ContactSimulator.step`): a token of the scalars; the memory
+        is journalled by the first kernel call (`advance`), so a step that succeeds copies
+        nothing but that."""
+        self._journal = None
+        return (self.radius, self.row, self.dissipated, self._memory_peak, self._edge, self._edge_depth)
+
+    def rollback(self, token: tuple) -> None:
+        """Undo everything since `begin` returned `token`."""
+        journal = self._journal
+        if journal is not None:
+            _kernels._restore_state(
+                journal.wl, journal.wsum, journal.wb, journal.bsum, journal.txn, journal.txn_b
+            )
+            self._journal = None
+        self.radius, self.row, self.dissipated, self._memory_peak, self._edge, self._edge_depth = token
 
     def is_relaxed(self) -> bool:
         if self.row is None:
@@ -568,6 +663,7 @@ class _TimeStepped:
         self.radius = radius
         self.dissipated = dissipated
         self._memory_peak = None
+        self._edge_depth = math.nan
         if row is None:
             self.row = None
         elif row is self.row:
@@ -582,6 +678,51 @@ class _TimeStepped:
         self.row = None
         self.dissipated = 0.0
         self._memory_peak = None
+        self._journal = None
+        self._edge_depth = math.nan
+
+
+def _bracketed_root(
+    residual: Any, a: float, fa: float, b: float, fb: float, tol: float
+) -> tuple[float, float]:
+    """A root of `residual` in the bracket [a, b] (``fa``, ``fb`` of opposite signs):
+    Illinois (regula falsi that halves the stale end's value) with a bisection whenever the
+    bracket failed to halve in three steps. Stops when ``|residual| <= tol`` (N, the force
+    tolerance) or the bracket is down to 1e-15 relative (a jump across the target: the
+    caller flags it). Returns (x, residual(x)) of the best point (the smaller |residual|)."""
+    # ra, rb: the true residuals at a and b; fa, fb: the (Illinois-weighted) ones the
+    # interpolation uses.
+    ra, rb = fa, fb
+    side = 0
+    width = abs(b - a)
+    since_halved = 0
+    for _ in range(200):
+        if abs(ra) <= tol:
+            return a, ra
+        if abs(rb) <= tol:
+            return b, rb
+        if abs(b - a) <= 1e-15 * max(abs(a), abs(b), 1e-300):
+            break
+        x = (a * fb - b * fa) / (fb - fa) if since_halved < 3 else 0.5 * (a + b)
+        if not min(a, b) < x < max(a, b):
+            x = 0.5 * (a + b)
+        fx = residual(x)
+        if (fx < 0.0) == (rb < 0.0):
+            b, fb, rb = x, fx, fx
+            if side == -1:
+                fa *= 0.5
+            side = -1
+        else:
+            a, fa, ra = x, fx, fx
+            if side == 1:
+                fb *= 0.5
+            side = 1
+        if abs(b - a) <= 0.5 * width:
+            width = abs(b - a)
+            since_halved = 0
+        else:
+            since_halved += 1
+    return (a, ra) if abs(ra) <= abs(rb) else (b, rb)
 
 
 def _columns(outputs: list[StepOutput]) -> dict[str, np.ndarray]:
@@ -744,11 +885,19 @@ class ContactSimulator:
         """Advance to `time` (s) under displacement control (`depth`, m) or force control
         (`force`, N); exactly one of them. Returns the new StepOutput. On any error the
         state is left as it was before the call."""
-        snapshot = self.snapshot()
+        saved = (
+            self._model.begin(),
+            self._time,
+            self._depth,
+            self._output,
+            self._energy_input,
+            self._held_force,
+        )
         try:
             return self._step(time, depth, force)
         except BaseException:
-            self.restore(snapshot)
+            self._model.rollback(saved[0])
+            self._time, self._depth, self._output, self._energy_input, self._held_force = saved[1:]
             raise
 
     def _step(self, time: float, depth: float | None, force: float | None) -> StepOutput:
@@ -813,7 +962,7 @@ class ContactSimulator:
         r0 = np.concatenate(([self._output.contact_radius], radius[:-1]))
         dt = np.diff(t, prepend=self._time)
         energy_input = np.cumsum(np.concatenate(([self._energy_input], work)))[1:]
-        g = np.asarray(physics.profile.g(radius), dtype=np.float64)
+        g = gaps[:, 2]  # g at the edge as the kernel saw it (0 without contact), like `step`
         tol = 1e-9 * (np.abs(d) + physics.c_crit * np.sqrt(radius) + g)
         pinned = np.where(
             gaps[:, 0] >= -tol, Phase.INDENTING, np.where(gaps[:, 1] <= tol, Phase.DETACHING, Phase.STICKING)
@@ -860,7 +1009,7 @@ class ContactSimulator:
     def _trial(self, time: float, depth: float) -> tuple[float, float, float]:
         """Advance the model (only) from the current state to (time, depth); returns
         (radius m, force N, work J). An idle contact above the surface costs nothing."""
-        if self.is_idle and depth < 0.0 and self._depth < 0.0:
+        if depth < 0.0 and self._depth < 0.0 and self.is_idle:
             if isinstance(self._model, _TimeStepped):
                 self._model.drop_memory()
             return 0.0, 0.0, 0.0
@@ -868,9 +1017,15 @@ class ContactSimulator:
 
     def _move(self, time: float, depth: float, *, unstable: bool) -> StepOutput:
         """Advance the model from the current state to (time, depth) and publish the output."""
+        return self._publish(time, depth, self._trial(time, depth), unstable=unstable)
+
+    def _publish(
+        self, time: float, depth: float, result: tuple[float, float, float], *, unstable: bool
+    ) -> StepOutput:
+        """Take the model's trial `result` (radius, force, work) at (time, depth) as the step."""
         dt = time - self._time
         r0 = self._output.contact_radius
-        radius, force, work = self._trial(time, depth)
+        radius, force, work = result
         self._energy_input += work
         self._time, self._depth = time, depth
         self._output = self._make_output(time, depth, force, r0, radius, dt, unstable)
@@ -880,6 +1035,7 @@ class ContactSimulator:
         self, time: float, depth: float, force: float, r0: float, radius: float, dt: float, unstable: bool
     ) -> StepOutput:
         physics = self.physics
+        g_edge = self._model.edge_height(radius) if radius > 0.0 else 0.0
         if radius <= 0.0:
             phase = Phase.NO_CONTACT
         elif radius > r0:
@@ -889,7 +1045,7 @@ class ContactSimulator:
         else:
             # Pinned edge: say which criterion it rests on, if any (elastic contacts at
             # rest sit on both; a punch rim blocks attachment).
-            tol = 1e-9 * (abs(depth) + physics.c_crit * math.sqrt(radius) + float(physics.profile.g(radius)))
+            tol = 1e-9 * (abs(depth) + physics.c_crit * math.sqrt(radius) + g_edge)
             outside, inside = self._model.edge_gaps(depth)
             if outside >= -tol:
                 phase = Phase.INDENTING
@@ -899,18 +1055,20 @@ class ContactSimulator:
                 phase = Phase.STICKING
         edge_speed = (radius - r0) / dt if dt > 0.0 else 0.0
         dissipated = self._model.energy_dissipated(self._energy_input, depth)
-        return StepOutput(
-            time=time,
-            depth=depth,
-            force=force,
-            contact_radius=radius,
-            phase=phase,
-            edge_speed=edge_speed,
-            effective_work_of_adhesion=physics.effective_work(depth, radius),
-            energy_input=self._energy_input,
-            energy_dissipated=dissipated,
-            scale_separation_ok=physics.scale_separation_ok(edge_speed),
-            unstable=unstable,
+        u = depth - g_edge
+        effective = physics.e_relaxed * u * u / (2.0 * math.pi * radius) if radius > 0.0 and u < 0.0 else 0.0
+        return _new_output(
+            time,
+            depth,
+            force,
+            radius,
+            phase,
+            edge_speed,
+            effective,
+            self._energy_input,
+            dissipated,
+            physics.scale_separation_ok(edge_speed),
+            unstable,
         )
 
     # -- force control ----------------------------------------------------------------------
@@ -937,23 +1095,41 @@ class ContactSimulator:
         start = self.snapshot()
         d0 = self._depth
         tol = self.numerics.force_tolerance * max(abs(target), abs(self._output.force), 1e-300)
+        # The root search stops within half the tolerance relative to the commanded force,
+        # floored at 1e-6 of the contact's adhesive force scale 2 E0* a dl_c(a) (the JKR
+        # adhesive term at the current radius): a zero force commanded to a contact in
+        # adhesive equilibrium is not chased down to 1e-300 N (44 trials per step).
+        radius = self._output.contact_radius
+        adhesive = 2.0 * self.physics.e0 * radius * self.physics.c_crit * math.sqrt(radius)
+        stop = 0.5 * self.numerics.force_tolerance * max(abs(target), 1e-6 * adhesive, 1e-300)
         was_in_contact = self.in_contact
 
+        model = self._model
+        last: list[Any] = [None, None]  # depth of the last trial and its (radius, force, work)
+
         def residual(depth: float) -> float:
-            self._model.set_state(start.model_state)
-            return self._trial(time, depth)[1] - target
+            model.rewind(start.model_state)
+            result = self._trial(time, depth)
+            last[0], last[1] = depth, result
+            return result[1] - target
 
         r_hold = residual(d0)
         if abs(r_hold) <= tol:
-            self.restore(start)
-            return self._move(time, d0, unstable=False)
+            return self._publish(time, d0, last[1], unstable=False)
         direction = 1.0 if r_hold < 0.0 else -1.0
         if direction < 0.0 and not self._attached() and not was_in_contact:
             # Out of contact and pulled away: no equilibrium, the indenter stays off.
-            self.restore(start)
-            return self._move(time, d0, unstable=target < 0.0)
-        delta = max(abs(r_hold) / self._stiffness_guess(), 1e-12 * (abs(d0) + 1e-12))
-        lo = d0
+            return self._publish(time, d0, last[1], unstable=target < 0.0)
+        # First bracketing step: the Newton step on the contact's instantaneous (glass)
+        # stiffness 2 E0* a, the stiffest the contact can answer, so the step falls short of
+        # the root rather than past it and the doubling below reaches the root nearest the
+        # previous depth first (the 0.1.0 lesson near the fold). Out of contact: the old
+        # relaxed-stiffness scale.
+        stiffness = self._stiffness_guess()
+        if self._output.contact_radius > 0.0:
+            stiffness *= self.physics.e0 / self.physics.e_relaxed
+        delta = max(abs(r_hold) / stiffness, 1e-12 * (abs(d0) + 1e-12))
+        lo, r_lo = d0, r_hold
         last_contact = d0
         for _ in range(200):
             hi = lo + direction * delta
@@ -967,26 +1143,20 @@ class ContactSimulator:
                 hi, r_hi = found
                 break
             last_contact = hi
-            lo = hi
+            lo, r_lo = hi, r_hi
             delta *= 2.0
         else:
             self.restore(start)
             raise InputError(f"force {target!r} N cannot be reached from depth {d0!r} m")
-        root = brentq(
-            residual,
-            min(lo, hi),
-            max(lo, hi),
-            xtol=1e-15 * max(abs(lo), abs(hi), 1e-300),
-            rtol=1e-15,
-            maxiter=200,
-        )
-        r_root = residual(root)
+        root, r_root = _bracketed_root(residual, lo, r_lo, hi, r_hi, stop)
+        if last[0] != root:
+            r_root = residual(root)
         jumped_in = not was_in_contact and self._attached() and self.physics.work_of_adhesion > 0.0
         # A residual left at the root means the force jumped across the target (snap-in or
         # a discontinuous edge): no continuous equilibrium path; keep the state reached.
         unstable = abs(r_root) > max(tol, 1e-9 * abs(target)) or jumped_in
-        self.restore(start)
-        return self._move(time, root, unstable=unstable)
+        # The model is in the state of the trial at the root: publish it (no second trial).
+        return self._publish(time, root, last[1], unstable=unstable)
 
     def _search_dip(self, residual, detached: float, attached: float) -> tuple[float, float] | None:
         """Between an attached and a detached trial depth, look for a force below the target
@@ -1006,17 +1176,28 @@ class ContactSimulator:
         # Golden-section on the attached interval for the force minimum.
         a, b = hi, attached
         golden = 0.5 * (math.sqrt(5.0) - 1.0)
-        for _ in range(60):
-            c = b - golden * (b - a)
-            d = a + golden * (b - a)
-            rc, rd = residual(c), residual(d)
-            for x, r in ((c, rc), (d, rd)):
-                if r <= 0.0:
-                    return x, r
+        c = b - golden * (b - a)
+        d = a + golden * (b - a)
+        rc = residual(c)
+        if rc <= 0.0:
+            return c, rc
+        rd = residual(d)
+        if rd <= 0.0:
+            return d, rd
+        # One new trial per iteration: the interior point that stays is reused.
+        for _ in range(120):
             if rc < rd:
-                b = d
+                b, d, rd = d, c, rc
+                c = b - golden * (b - a)
+                rc = residual(c)
+                if rc <= 0.0:
+                    return c, rc
             else:
-                a = c
+                a, c, rc = c, d, rd
+                d = a + golden * (b - a)
+                rd = residual(d)
+                if rd <= 0.0:
+                    return d, rd
             if abs(b - a) <= 1e-10 * max(abs(a), abs(b), 1e-300):
                 break
         return None
