@@ -112,6 +112,12 @@ def test_tutorial_2_fit_recovers_the_recorded_material(tmp_path):
         err_msg="tutorial 2: fitted G0 and work of adhesion vs the recorded material",
     )
     assert (out / "replay_fitted.png").read_bytes()[:4] == b"\x89PNG"
+    with open(out / "archive_replayed" / "summary.csv") as file:
+        rows = list(csv.DictReader(file))
+    assert sorted(Path(r["bag"]).name for r in rows) == ["monday.mcap", "tuesday.mcap"], rows
+    assert all(r["status"] == "ok" for r in rows), rows
+    for row in rows:  # each bag is the recording replayed once more with the fitted scene
+        assert float(row["rmse_N"]) == pytest.approx(after["rmse_N"], rel=1e-9), (row, after)
 
 
 def test_tutorial_3_lab_reaches_the_papers_slow_limit(tmp_path):
