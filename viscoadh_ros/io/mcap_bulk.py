@@ -35,18 +35,24 @@ from mcap.records import (
     Chunk,
     ChunkIndex,
     DataEnd,
-    Footer,
     Header,
     Metadata,
     MetadataIndex,
     Schema,
     Statistics,
-    SummaryOffset,
 )
 from numpy.typing import NDArray
 
 from viscoadh_ros import __version__
-from viscoadh_ros.io.mcap_log import METADATA_NAME, SCENE_KEY, VERSION_KEY, TopicData, TopicQos, plain
+from viscoadh_ros.io.mcap_log import (
+    METADATA_NAME,
+    SCENE_KEY,
+    VERSION_KEY,
+    TopicData,
+    TopicQos,
+    plain,
+    summary_and_footer,
+)
 from viscoadh_ros.io.ros_schemas import schema_text
 
 _MAGIC = b"\x89MCAP0\r\n"
@@ -201,9 +207,7 @@ def write_columns(
     DataEnd(data_section_crc=zlib.crc32(out)).write(builder)
     out += builder.end()
 
-    summary_start = len(out)
-    groups = []
-    for opcode, records in (
+    sections = (
         (Opcode.SCHEMA, list(schemas.values())),
         (Opcode.CHANNEL, channels),
         (Opcode.STATISTICS, [_statistics(which, times, len(schemas), len(channels), len(chunk_indexes))]),
@@ -212,26 +216,8 @@ def write_columns(
             Opcode.METADATA_INDEX,
             [MetadataIndex(offset=metadata_offset, length=metadata_length, name=METADATA_NAME)],
         ),
-    ):
-        group_start = summary_start + builder.count
-        for record in records:
-            record.write(builder)
-        groups.append(
-            SummaryOffset(
-                group_opcode=opcode,
-                group_start=group_start,
-                group_length=summary_start + builder.count - group_start,
-            )
-        )
-    offset_start = summary_start + builder.count
-    for group in groups:
-        group.write(builder)
-    summary = builder.end()
-    footer_head = struct.pack("<BQQQ", Opcode.FOOTER, 20, summary_start, offset_start)
-    out += summary
-    crc = zlib.crc32(footer_head, zlib.crc32(summary))
-    Footer(summary_start=summary_start, summary_offset_start=offset_start, summary_crc=crc).write(builder)
-    out += builder.end() + _MAGIC
+    )
+    out += summary_and_footer(builder, len(out), sections)
     Path(path).write_bytes(out)
 
 

@@ -357,35 +357,46 @@ class _File:
             message_end_time=max((t[1] for t in times), default=0),
             channel_message_counts={c.id: counts[c.id] for c in self._channel_records},
         )
-        groups = []
-        for opcode, records in (
+        sections = (
             (Opcode.SCHEMA, list(self._schemas.values())),
             (Opcode.CHANNEL, self._channel_records),
             (Opcode.STATISTICS, [statistics]),
             (Opcode.CHUNK_INDEX, self._chunk_indexes),
             (Opcode.METADATA_INDEX, self._metadata_indexes),
-        ):
-            if not records:
-                continue
-            group_start = summary_start + builder.count
-            for record in records:
-                record.write(builder)
-            groups.append(
-                SummaryOffset(
-                    group_opcode=opcode,
-                    group_start=group_start,
-                    group_length=summary_start + builder.count - group_start,
-                )
-            )
-        offset_start = summary_start + builder.count
-        for group in groups:
-            group.write(builder)
-        summary = builder.end()
-        footer_head = struct.pack("<BQQQ", Opcode.FOOTER, 20, summary_start, offset_start)
-        crc = zlib.crc32(footer_head, zlib.crc32(summary))
-        Footer(summary_start=summary_start, summary_offset_start=offset_start, summary_crc=crc).write(builder)
-        self.stream.write(summary + builder.end() + _MAGIC)
+        )
+        self.stream.write(summary_and_footer(builder, summary_start, sections))
         self.stream.close()
+
+
+def summary_and_footer(
+    builder: RecordBuilder, summary_start: int, sections: Sequence[tuple[int, list]]
+) -> bytes:
+    """The bytes that end an MCAP file whose summary section starts at file offset
+    ``summary_start``: each non-empty ``(opcode, records)`` group of ``sections``, the summary
+    offsets of the groups, the footer with the summary's CRC, and the closing magic. ``builder``
+    must be empty; both writers (`_File` and `mcap_bulk.write_columns`) end their files here."""
+    groups = []
+    for opcode, records in sections:
+        if not records:
+            continue
+        group_start = summary_start + builder.count
+        for record in records:
+            record.write(builder)
+        groups.append(
+            SummaryOffset(
+                group_opcode=opcode,
+                group_start=group_start,
+                group_length=summary_start + builder.count - group_start,
+            )
+        )
+    offset_start = summary_start + builder.count
+    for group in groups:
+        group.write(builder)
+    summary = builder.end()
+    footer_head = struct.pack("<BQQQ", Opcode.FOOTER, 20, summary_start, offset_start)
+    crc = zlib.crc32(footer_head, zlib.crc32(summary))
+    Footer(summary_start=summary_start, summary_offset_start=offset_start, summary_crc=crc).write(builder)
+    return summary + builder.end() + _MAGIC
 
 
 class McapRecorder:
