@@ -20,7 +20,6 @@ import math
 from fit_records import DEPTH_TOPIC, TRUE, scene, standard_history, write_record
 
 from viscoadh_ros.core.history import simulate_history
-
 from viscoadh_ros.experiment import load_experiment
 from viscoadh_ros.fitting import fit
 from viscoadh_ros.io.bag import Bag
