@@ -18,19 +18,32 @@ How it finds the optimum from a poor start (issue 12):
    started.
 2. **The pull-off jump is masked**: a measured change between two samples beyond the noise
    and against the depth's change (:func:`smooth_samples`) is left out with
-   :data:`JUMP_MARGIN` samples either side.
-3. **A global stage**: the cost at :data:`GLOBAL_POINTS` scrambled-Sobol points of the box
-   (seeded: same record and options, same numbers), then a local descent (``least_squares``,
-   trust region in the box) from the start and from the best global points, keeping the
-   lowest cost. The descent's difference step is matched to what roughness remains
+   :data:`JUMP_MARGIN` samples, and at least :data:`JUMP_WINDOW` of the record, either side.
+3. **A coarse global stage**: on the fit's grid at the start's preset, on at most
+   :data:`COARSE_SAMPLES` of the used samples (every k-th) and with the jump masks
+   :data:`COARSE_JUMP_WINDOW` of the record wide (far from the optimum the model's own
+   pull-off lands samples away from the measured one: each sample it crosses moves the cost
+   by ``(pull-off / noise)^2``, a staircase no descent climbs). A local descent
+   (``least_squares``, trust region in the box) from the start; when its fit error is above
+   the noise, the cost at :data:`GLOBAL_POINTS` scrambled-Sobol points of the box (seeded:
+   same record and options, same numbers) and descents from the best; the lowest cost wins.
+   The descent's difference step is matched to what roughness remains
    (:func:`_difference_step`).
+3b. **The polish grid from the noise** (:func:`polish_elements`): the fit's grid with the
+   element count `numerics_for_tolerance` chooses for a model error of
+   :data:`MODEL_ERROR_FRACTION` of the record's noise (both relative to its pull-off force),
+   so the cost near the optimum is noise-dominated and smooth at the scale of a standard
+   deviation; the polish and the intervals run on it, on every used sample.
 4. **A stationarity test**: at the optimum a central secant Jacobian gives the Gauss-Newton
    step; if it still proposes more than one standard deviation in any parameter the fit takes
    it and descends again, and a fit whose step stays above :data:`STATIONARY_SIGMAS` is
    reported as not converged, never as a success.
 5. **Intervals**: linearised from the secant Jacobian, ``cov = s^2 (J^T J)^-1`` with the
-   residual variance ``s^2``, plus a model-error term for the discretisation: the shift of
-   the optimum that refining the grid (twice the elements) would cause, added in quadrature.
+   residual variance ``s^2``, widened where the cost along a parameter's profile direction
+   rises less than the linear model says (:func:`_profile_inflation`, never narrowed), plus
+   a model-error term for the discretisation: the shift of the optimum that refining the
+   grid (twice the elements) would cause (its Gauss-Newton step from one model run on the
+   refined grid against the polish's Jacobian), added in quadrature.
    The 95 % interval is ``u +- 1.96 sigma_u`` (asymmetric in the parameter). Their coverage is
    tested on seeded synthetic records (tests/test_fit_coverage.py).
 
@@ -80,10 +93,11 @@ SECANT_SIGMAS = 3.0
 #: Narrowest secant, in u: wide against the roughness of long records (whose standard
 #: deviations are small), narrow against the curvature (its bias ~ width^2 is ~1e-5 here).
 MIN_SECANT = 5e-3
-#: Grid refinements (elements x2 each) of the polish at most, and the shift of the optimum
-#: (in standard deviations) below which a refinement is the last.
-MAX_REFINEMENTS = 2
-REFINED_SIGMAS = 1.0
+#: The profile check of the intervals: the cost at this many standard deviations along each
+#: parameter's profile direction; a mean rise below this fraction of the linear model's widens
+#: the interval (`_profile_inflation`).
+PROFILE_SIGMAS = 3.0
+PROFILE_TRUST = 0.25
 #: Default half-width of the search box: each free parameter within start/10 .. start*10.
 BOUNDS_FACTOR = 10.0
 #: Scrambled-Sobol points of the global stage, and how many of the best start local descents.
@@ -113,10 +127,24 @@ JUMP_MARGIN = 2
 #: in a row at zero within them.
 PULL_OFF_NOISE_BAND = 5.0
 PULL_OFF_FREE_SAMPLES = 5
+#: ... and at least this fraction of the record's samples either side: within it the force
+#: before a pull-off is so steep in the parameters that a secant of a few standard deviations
+#: reads the model's pull-off crossing samples as slope (measured on 5000 samples: 0.2 % of
+#: the record makes secants of 1e-3 and 5e-3 agree, and the interval of G0 6x wider, honest).
+JUMP_WINDOW = 0.005
 #: The fit's grid: this margin over the largest reachable contact radius, and at most this
 #: many times the preset's elements to keep the start's contact as finely resolved.
 GRID_MARGIN = 1.2
 MAX_ELEMENT_FACTOR = 4
+#: The polish's model error (`numerics_for_tolerance`, relative to the pull-off force) is at
+#: most this fraction of the record's noise (relative to the same force): the cost near the
+#: optimum is then noise-dominated and smooth at the scale of a standard deviation.
+MODEL_ERROR_FRACTION = 0.5
+#: The global stage and the first descents see at most this many samples (every k-th used
+#: one): the coarse grid's roughness is then small against their wider standard deviations.
+COARSE_SAMPLES = 1000
+#: ... and their jump masks reach this fraction of the record's samples either side.
+COARSE_JUMP_WINDOW = 0.02
 
 
 class FitError(InputError):
@@ -461,6 +489,35 @@ class _Problem:
         return np.column_stack(columns)
 
 
+def _widen(keep: NDArray[np.bool_], fraction: float) -> NDArray[np.bool_]:
+    """``keep`` with every masked run widened by ``fraction`` of its samples either side
+    (at least JUMP_MARGIN): a jump mask measured in time, not in samples."""
+    window = max(JUMP_MARGIN, int(fraction * keep.size))
+    near = np.convolve((~keep).astype(np.int64), np.ones(2 * window + 1, dtype=np.int64), "same") > 0
+    return keep & ~near
+
+
+def polish_elements(contact: ContactConfig, noise: float, force_scale: float, coarse: int) -> int:
+    """Elements of the polish's grid: the element count `numerics_for_tolerance` chooses for a
+    model error of MODEL_ERROR_FRACTION of ``noise / force_scale`` (``force_scale`` the
+    pull-off force, N), scaled like the fit's grid (``coarse`` elements against the preset's),
+    never fewer than ``coarse``. A tolerance tighter than the ladder can meet takes its last
+    rung."""
+    from viscoadh_ros.core.errors import ConfigError
+    from viscoadh_ros.core.presets import ELEMENT_LADDER, SceneHint, numerics_for_tolerance, resolve_numerics
+
+    tolerance = min(MODEL_ERROR_FRACTION * noise / max(force_scale, 1e-300), 0.5)
+    hint = SceneHint.of(contact.indenter, contact.material)
+    try:
+        chosen = numerics_for_tolerance(tolerance, hint).elements
+    except ConfigError:
+        chosen = ELEMENT_LADDER[-1]
+    preset_numerics = dataclasses.replace(contact.numerics, elements=0, tolerance=0.0)
+    preset_elements = resolve_numerics(preset_numerics).elements
+    factor = coarse / preset_elements
+    return max(coarse, int(math.ceil(chosen * max(factor, 1.0))))
+
+
 def _identify_checks(
     experiment: Experiment, free: Sequence[str], used: NDArray[np.bool_], selected: NDArray[np.bool_]
 ) -> None:
@@ -529,6 +586,8 @@ class _Polished:
     flat: list[str]
     sigmas: NDArray[np.float64]  # the last proposed step, in standard deviations
     steps: NDArray[np.float64]  # the last secant's half-widths
+    jac: NDArray[np.float64]  # the last secant Jacobian of the residuals
+    r: NDArray[np.float64]  # the residuals at u
 
     @property
     def sigma_u(self) -> NDArray[np.float64]:
@@ -584,7 +643,44 @@ def _polish(
                 break
         else:
             break
-    return _Polished(u, cov, flat, sigmas, steps)
+    return _Polished(u, cov, flat, sigmas, steps, jac, r)
+
+
+def _profile_inflation(
+    problem: _Problem, polished: _Polished, lower: NDArray[np.float64], upper: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """Factor (>= 1) on each linearised standard deviation from the cost itself: along the
+    profile direction of parameter j (``cov[:, j] / sigma_j``: u_j moves, the others follow
+    its valley) the linear model predicts a rise of ``(k s)^2`` at ``k = PROFILE_SIGMAS``
+    standard deviations either side. Where the mean measured rise is below PROFILE_TRUST of
+    that (on long records the secant reads the model's roughness, single samples flipping as
+    element events cross stamps, as slope, and the valley is wider than it says) it is
+    measured again that much wider and the deviation scaled to what the cost shows. 4p model
+    runs at most."""
+    u, cov, r = polished.u, polished.cov, polished.r
+    dof = max(r.size - u.size, 1)
+    s2 = float(r @ r) / dof
+    base = float(r @ r)
+    factors = np.ones(u.size)
+    for j in range(u.size):
+        sigma = math.sqrt(cov[j, j]) if math.isfinite(cov[j, j]) else math.inf
+        if not math.isfinite(sigma) or sigma <= 0.0 or not np.all(np.isfinite(cov[:, j])):
+            continue
+        direction = cov[:, j] / sigma
+        k = PROFILE_SIGMAS
+        for _ in range(2):
+            rises = []
+            for sign in (1.0, -1.0):
+                trial = np.clip(u + sign * k * direction, lower, upper)
+                rt = problem.residual(trial)
+                rises.append(float(rt @ rt) - base)
+            rise = max(float(np.mean(rises)), 1e-2 * s2)
+            expected = (k / factors[j]) ** 2 * s2  # k in the inflated deviations so far
+            if rise >= PROFILE_TRUST * expected:
+                break
+            factors[j] *= math.sqrt(expected / rise)
+            k = PROFILE_SIGMAS * factors[j]
+    return factors
 
 
 def fit(
@@ -615,7 +711,8 @@ def fit(
         experiment.time(experiment.measured_ns), experiment.time(experiment.input_ns), experiment.input_value
     )
     selected = segment_samples(experiment, options)
-    used = smooth_samples(experiment.measured_force, noise, depth) & selected
+    smooth = _widen(smooth_samples(experiment.measured_force, noise, depth), JUMP_WINDOW)
+    used = smooth & selected
     _identify_checks(experiment, free, used, selected)
 
     half = math.log(options.bounds_factor)
@@ -628,14 +725,25 @@ def fit(
     lower, upper = np.full(p, -half), np.full(p, half)
 
     def cost(u: NDArray[np.float64]) -> float:
-        r = problem.residual(u)
+        r = coarse.residual(u)
         return 0.5 * float(r @ r)
 
+    # The coarse stage: the fit's grid at the start's preset, on every k-th used sample.
+    # Its jump masks are COARSE_JUMP_WINDOW of the record wide on either side: far from the
+    # optimum the model's own pull-off lands samples away from the measured one, and each
+    # sample it crosses moves the cost by (pull-off / noise)^2, a staircase no descent climbs.
+    coarse_used = used & _widen(smooth, COARSE_JUMP_WINDOW)
+    if int(np.count_nonzero(coarse_used)) < len(free) + 2:
+        coarse_used = used
+    thin = max(1, math.ceil(int(np.count_nonzero(coarse_used)) / COARSE_SAMPLES))
+    picked = np.zeros_like(used)
+    picked[np.flatnonzero(coarse_used)[::thin]] = True
+    problem = coarse = _Problem(grid_contact, experiment, free, kelvin, start, picked, noise)
     step = _difference_step(problem, np.zeros(p))
 
     def descend(u0: NDArray[np.float64]) -> tuple[NDArray[np.float64], float]:
         found = least_squares(
-            problem.residual,
+            coarse.residual,
             np.clip(u0, lower + 1e-9, upper - 1e-9),
             bounds=(lower, upper),
             diff_step=step,
@@ -648,32 +756,53 @@ def fit(
     # error), the global stage: the cost at seeded Sobol points of the box and descents from
     # the best of them; the lowest cost wins.
     u, best = descend(np.zeros(p))
-    dof = max(problem.measured.size - p, 1)
-    if 2.0 * best / dof > 1.0 + NOISE_CONSISTENT * math.sqrt(2.0 / dof):
+
+    def noisy(chi2: float, dof: int) -> bool:
+        return chi2 / dof > 1.0 + NOISE_CONSISTENT * math.sqrt(2.0 / dof)
+
+    def explore(u: NDArray[np.float64], best: float) -> tuple[NDArray[np.float64], float]:
         sobol = qmc.Sobol(d=p, scramble=True, seed=options.seed).random(GLOBAL_POINTS)
         candidates = [lower + (upper - lower) * s for s in sobol]
         costs = [cost(c) for c in candidates]
         descents = [descend(candidates[i]) for i in np.argsort(costs)[:GLOBAL_DESCENTS]]
-        u, best = min([(u, best), *descents], key=lambda d: d[1])
+        return min([(u, best), *descents], key=lambda d: d[1])
 
-    # Polish on the secant model, then again on grids refined by 2 until the optimum stops
-    # moving: the last shift is the discretisation's model-error term.
+    explored = noisy(2.0 * best, max(coarse.measured.size - p, 1))
+    if explored:
+        u, best = explore(u, best)
+
+    # Polish on the secant model on every used sample and the grid whose model error sits
+    # below the noise, then again on grids refined by 2 until the optimum stops moving: the
+    # last shift is the discretisation's model-error term.
     smallest = max(step / 3.0, MIN_SECANT)
-    model_time = 0.0
+    model_time = problem.model_time
+    pull_off = float(np.max(np.abs(np.minimum(experiment.measured_force[used], 0.0))))
+    scale = pull_off if pull_off > PULL_OFF_NOISE_BAND * noise else float(np.max(np.abs(problem.measured)))
+    elements = polish_elements(contact, noise, scale, elements)
+    numerics = dataclasses.replace(numerics, elements=elements)
+    grid_contact = dataclasses.replace(grid_contact, numerics=numerics)
+    problem = _Problem(grid_contact, experiment, free, kelvin, start, used, noise, runs=problem.runs)
     polished = _polish(problem, u, lower, upper, smallest)
     if float(np.max(polished.sigmas)) > STATIONARY_SIGMAS:
         # The polish stopped on a rough patch: descend once more from where it got to.
         polished = _polish(problem, descend(polished.u)[0], lower, upper, smallest)
-    shift = np.zeros(p)
-    for _ in range(MAX_REFINEMENTS):
-        elements *= 2
-        finer = dataclasses.replace(grid_contact, numerics=dataclasses.replace(numerics, elements=elements))
-        model_time += problem.model_time
-        problem = _Problem(finer, experiment, free, kelvin, start, used, noise, runs=problem.runs)
-        refined = _polish(problem, polished.u, lower, upper, smallest, polished.steps)
-        shift, polished = refined.u - polished.u, refined
-        if np.all(np.abs(shift) <= REFINED_SIGMAS * polished.sigma_u):
-            break
+    dof = max(problem.measured.size - p, 1)
+    if not explored and noisy(float(polished.r @ polished.r), dof):
+        # Above the noise on every sample though the thinned set looked noise-consistent (its
+        # test is sqrt(k) looser): a local valley; the global stage decides after all.
+        runs, spent = coarse.runs, coarse.model_time
+        found, _ = explore(polished.u, cost(polished.u))
+        problem.runs, model_time = problem.runs + coarse.runs - runs, model_time + coarse.model_time - spent
+        if found is not polished.u:
+            other = _polish(problem, found, lower, upper, smallest)
+            if float(other.r @ other.r) < float(polished.r @ polished.r):
+                polished = other
+    # The model-error term: the Gauss-Newton step the grid refined by 2 proposes (its residuals
+    # at the optimum against this grid's secant Jacobian, one model run) less this grid's own.
+    finer = dataclasses.replace(grid_contact, numerics=dataclasses.replace(numerics, elements=2 * elements))
+    refined = _Problem(finer, experiment, free, kelvin, start, used, noise, runs=problem.runs)
+    shift = np.linalg.lstsq(polished.jac, polished.r - refined.residual(polished.u), rcond=None)[0]
+    problem.runs, model_time = refined.runs, model_time + refined.model_time
     u, cov, flat, sigmas = polished.u, polished.cov, polished.flat, polished.sigmas
     model_contact = problem.contact
     worst = int(np.argmax(sigmas))
@@ -682,7 +811,8 @@ def fit(
             f"the fit did not converge: at its end the secant still proposes a step of "
             f"{sigmas[worst]:.1f} standard deviations in {free[worst]}"
         )
-    sigma_u = np.sqrt(np.diag(cov) + shift**2)
+    inflation = _profile_inflation(problem, polished, lower, upper)
+    sigma_u = np.sqrt(np.diag(cov) * inflation**2 + shift**2)
 
     values = problem.values(u)
     uncertainty, interval, identified = {}, {}, {}

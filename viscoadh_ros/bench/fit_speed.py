@@ -4,8 +4,10 @@ Records are made here by an independent model run (`simulate_history` at the ``a
 preset, the simulator's own grid) plus seeded 1 % Gaussian load-cell noise, on a 10 mm sphere:
 a fast press to 10 um, a hold, a partial unload, a slower press to 20 um, a hold and a
 retraction past pull-off over 0.2 s (ramps of 10-70 ms against a retardation time of 10 ms).
-The fits (`fitting.fit`, ``fast`` preset, all parameters free) start from the truth times a
-seeded factor in 1/3 .. 3 per parameter. Per fit: wall and CPU time, model runs and the share
+The fits (`fitting.fit`, all parameters free; the start scene's ``fast`` preset on the fit's
+grid for the coarse stage, the polish on the element count the record's noise calls for,
+`fitting.polish_elements`) start from the truth times a seeded factor in 1/3 .. 3 per
+parameter. Per fit: wall and CPU time, model runs and the share
 of time in them, whether every parameter is within 5 % of the truth and whether the truth
 lies within the stated 95 % intervals.
 """
