@@ -280,7 +280,7 @@ class FitResult:
     contact: ContactConfig  # the base contact with the fitted values (its own numerics)
     model_contact: ContactConfig  # the same on the fit's grid (what the fit ran)
     used: NDArray[np.bool_]  # (m,) measured samples in the residuals
-    status: str  # "ok" or "unidentified" (some parameter not identified)
+    status: str  # "ok", "unidentified" (some parameter not identified) or "misfit" (see reason)
     reason: str  # empty, or which parameters the record cannot fix and why
     model_runs: int
     wall_time: float  # s
@@ -318,6 +318,23 @@ def noise_level(force: NDArray[np.float64]) -> float:
         return 0.0
     d2 = np.diff(force, 2)
     return 1.4826 * float(np.median(np.abs(d2 - np.median(d2)))) / math.sqrt(6.0)
+
+
+#: Lag-1 autocorrelation of the residuals beyond this many of its standard errors (1/sqrt(n)
+#: for white noise) marks a systematic misfit: a fit whose RMSE sits near the noise can still
+#: miss the record along a smooth stretch (a local optimum, a missing Kelvin element), which
+#: the RMSE cannot tell from an error in the noise estimate but correlated residuals do.
+MISFIT_SIGMAS = 4.0
+
+
+def residual_correlation(error: NDArray[np.float64]) -> float:
+    """Lag-1 autocorrelation of residuals ``error`` (0 for white noise; about 1 for a smooth
+    misfit), over the samples in their order."""
+    if error.size < 3:
+        return 0.0
+    e = error - float(np.mean(error))
+    denominator = float(e @ e)
+    return float(e[1:] @ e[:-1]) / denominator if denominator > 0.0 else 0.0
 
 
 def _noise_floor(force: NDArray[np.float64]) -> float:
@@ -835,6 +852,18 @@ def fit(
         )
     force = problem.force(u)
     error = force - problem.measured
+    status = "unidentified" if unidentified else "ok"
+    correlation = residual_correlation(error)
+    if correlation * math.sqrt(error.size) > MISFIT_SIGMAS:
+        status = "misfit"
+        misfit = (
+            f"the residuals are correlated (lag-1 autocorrelation {correlation:.3f}, "
+            f"{correlation * math.sqrt(error.size):.1f} standard errors of white noise): the model "
+            "misses the record systematically (a local optimum, a missing Kelvin element, a wrong "
+            "indenter) or the recorder filtered its noise; the values are not to be trusted as a "
+            "fit and the intervals, which assume white noise, are too narrow"
+        )
+        reason = f"{misfit}; {reason}" if reason else misfit
     spread = float(np.sum((problem.measured - np.mean(problem.measured)) ** 2))
     return FitResult(
         values=values,
@@ -850,7 +879,7 @@ def fit(
         contact=with_parameters(contact, values, kelvin),
         model_contact=with_parameters(model_contact, values, kelvin),
         used=used,
-        status="unidentified" if unidentified else "ok",
+        status=status,
         reason=reason,
         model_runs=problem.runs,
         wall_time=wallclock.perf_counter() - started,

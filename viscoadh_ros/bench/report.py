@@ -125,6 +125,7 @@ def fit_section(fit: dict[str, Any]) -> list[str]:
             f"- {name}, RMSE/noise {_g(f['rmse_over_noise'])}, errors "
             + ", ".join(f"{n} {e:+.1%}" for n, e in f["errors"].items())
             + f", {f['covered']} of {len(f['errors'])} truths inside the stated 95 % interval"
+            + (", flagged `misfit` (correlated residuals)" if f["status"] == "misfit" else ", status ok")
             for name, f in missed
         ]
     failed = [
