@@ -35,3 +35,19 @@ def one_contact(
     if numerics:
         section["numerics"] = dict(numerics)
     return SceneConfig.from_dict({"contacts": ["c"], "c": section}).contact("c")
+
+
+#: The standard-solid finger most node, replay and fault tests use, as the flat parameters a node
+#: is given: a 10 mm sphere on G0 = 1 MPa, G1 = 0.2 MPa, eta1 = 2000 Pa s (retardation 10 ms),
+#: w = 0.05 J/m^2, `fast` numerics, forced onto the time-stepped model.
+STANDARD_SOLID_FINGER: dict[str, Any] = {
+    "contacts": ["finger"],
+    "finger.indenter.shape": "sphere",
+    "finger.indenter.radius": 0.01,
+    "finger.material.glass_shear_modulus": 1.0e6,
+    "finger.material.kelvin_shear_moduli": [2.0e5],
+    "finger.material.kelvin_viscosities": [2.0e3],
+    "finger.adhesion.work_of_adhesion": 0.05,
+    "finger.numerics.preset": "fast",
+    "finger.numerics.model": "time_stepped",
+}

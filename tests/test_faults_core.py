@@ -14,22 +14,13 @@ from typing import Any
 
 import numpy as np
 import pytest
+from scenes import STANDARD_SOLID_FINGER
 
 from viscoadh_ros.core.config import SceneConfig
 from viscoadh_ros.core.errors import InputError
 from viscoadh_ros.core.simulator import ContactSimulator
 
-SCENE = {
-    "contacts": ["finger"],
-    "finger.indenter.shape": "sphere",
-    "finger.indenter.radius": 0.01,
-    "finger.material.glass_shear_modulus": 1.0e6,
-    "finger.material.kelvin_shear_moduli": [2.0e5],
-    "finger.material.kelvin_viscosities": [2.0e3],
-    "finger.adhesion.work_of_adhesion": 0.05,
-    "finger.numerics.preset": "fast",
-    "finger.numerics.model": "time_stepped",
-}
+SCENE = STANDARD_SOLID_FINGER
 
 
 def _twins(**extra: Any) -> tuple[ContactSimulator, ContactSimulator]:

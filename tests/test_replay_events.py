@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 import pytest
 import yaml
+from scenes import STANDARD_SOLID_FINGER
 from viscoadh_msgs.msg import ContactEvent, IndentationCommand
 
 from viscoadh_ros.cli.main import main
@@ -28,19 +29,7 @@ from viscoadh_ros.io.bag import Bag
 from viscoadh_ros.io.mcap_log import McapRecorder, plain
 from viscoadh_ros.ros import conversions
 
-SCENE = SceneConfig.from_parameters(
-    {
-        "contacts": ["finger"],
-        "finger.indenter.shape": "sphere",
-        "finger.indenter.radius": 0.01,
-        "finger.material.glass_shear_modulus": 1.0e6,
-        "finger.material.kelvin_shear_moduli": [2.0e5],
-        "finger.material.kelvin_viscosities": [2.0e3],
-        "finger.adhesion.work_of_adhesion": 0.05,
-        "finger.numerics.preset": "fast",
-        "finger.numerics.model": "time_stepped",
-    }
-)
+SCENE = SceneConfig.from_parameters(STANDARD_SOLID_FINGER)
 MS = 1_000_000
 
 

@@ -20,6 +20,7 @@ from rcl_interfaces.msg import ParameterType, ParameterValue
 from rcl_interfaces.srv import SetParameters
 from rclpy.node import Node
 from rosgraph_msgs.msg import Clock
+from scenes import STANDARD_SOLID_FINGER
 from std_srvs.srv import Trigger
 from viscoadh_msgs.msg import ContactEvent, IndentationCommand
 
@@ -29,19 +30,7 @@ from viscoadh_ros.demo import _Driver, node_in_process
 from viscoadh_ros.io.bag import Bag
 from viscoadh_ros.ros.conversions import ns_to_stamp
 
-SCENE = SceneConfig.from_parameters(
-    {
-        "contacts": ["finger"],
-        "finger.indenter.shape": "sphere",
-        "finger.indenter.radius": 0.01,
-        "finger.material.glass_shear_modulus": 1.0e6,
-        "finger.material.kelvin_shear_moduli": [2.0e5],
-        "finger.material.kelvin_viscosities": [2.0e3],
-        "finger.adhesion.work_of_adhesion": 0.05,
-        "finger.numerics.preset": "fast",
-        "finger.numerics.model": "time_stepped",
-    }
-)
+SCENE = SceneConfig.from_parameters(STANDARD_SOLID_FINGER)
 #: Press to 20 um in 0.2 s, pull out to -30 um by 0.5 s, commands every 10 ms.
 TIMES = np.arange(0.0, 0.5, 0.01)
 DEPTHS = np.interp(TIMES, [0.0, 0.2, 0.5], [-1e-6, 20e-6, -30e-6])
