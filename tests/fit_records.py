@@ -15,6 +15,7 @@ import numpy as np
 import yaml
 from geometry_msgs.msg import PointStamped, WrenchStamped
 
+from viscoadh_ros.bench.fit_speed import probe_scene
 from viscoadh_ros.core.config import SceneConfig
 from viscoadh_ros.core.history import simulate_history
 from viscoadh_ros.io.mcap_log import McapRecorder, plain
@@ -27,19 +28,9 @@ DEPTH_TOPIC = "/probe/depth"
 
 
 def scene(values: dict[str, float], *, preset: str = "fast", kelvin: int = 1) -> SceneConfig:
-    """A one-contact scene ("probe", sphere R = 10 mm) with ``values`` (names as fitting's)."""
-    return SceneConfig.from_parameters(
-        {
-            "contacts": ["probe"],
-            "probe.indenter.shape": "sphere",
-            "probe.indenter.radius": 0.01,
-            "probe.material.glass_shear_modulus": values["G0"],
-            "probe.material.kelvin_shear_moduli": [values[f"G{k}"] for k in range(1, kelvin + 1)],
-            "probe.material.kelvin_viscosities": [values[f"eta{k}"] for k in range(1, kelvin + 1)],
-            "probe.adhesion.work_of_adhesion": values["work_of_adhesion"],
-            "probe.numerics.preset": preset,
-        }
-    )
+    """A one-contact scene ("probe", sphere R = 10 mm) with ``values`` (names as fitting's):
+    the bench's own record scene, so tests and bench fit the same experiment."""
+    return probe_scene(values, preset=preset, kelvin=kelvin)
 
 
 def standard_history(samples: int = 200, *, retract_to: float = -30e-6) -> tuple[np.ndarray, np.ndarray]:

@@ -29,7 +29,10 @@ NOISE = 0.01
 RECOVERY = 0.05  # "recovered": every parameter within 5 % of the truth
 
 
-def _contact(values: dict[str, float], kelvin: int, preset: str) -> Any:
+def probe_scene(values: dict[str, float], *, preset: str = "fast", kelvin: int = 1) -> Any:
+    """The one-contact scene the fit records are made and fitted with: contact "probe", a
+    sphere R = 10 mm, ``values`` named as `fitting` names parameters (``G0``, ``G1..GK``,
+    ``eta1..etaK``, ``work_of_adhesion``), ``kelvin`` Kelvin elements, numerics ``preset``."""
     from viscoadh_ros.core.config import SceneConfig
 
     return SceneConfig.from_parameters(
@@ -43,7 +46,11 @@ def _contact(values: dict[str, float], kelvin: int, preset: str) -> Any:
             "probe.adhesion.work_of_adhesion": values["work_of_adhesion"],
             "probe.numerics.preset": preset,
         }
-    ).contacts[0]
+    )
+
+
+def _contact(values: dict[str, float], kelvin: int, preset: str) -> Any:
+    return probe_scene(values, preset=preset, kelvin=kelvin).contacts[0]
 
 
 def make_record(path: Path, values: dict[str, float], kelvin: int, samples: int, seed: int) -> None:
