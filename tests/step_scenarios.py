@@ -63,6 +63,23 @@ def scenes() -> dict[str, object]:
             work=0.03,
             numerics={"preset": "fast"},
         ),
+        # A long interaction range: the edge is often slower than the criterion's critical
+        # speeds (scale_separation_ok false, advancing and receding thresholds apart).
+        "loose_range": SceneConfig.from_dict(
+            {
+                "contacts": ["c"],
+                "c": {
+                    "indenter": {"shape": "sphere", "radius": 0.01},
+                    "material": {
+                        "glass_shear_modulus": 1e6,
+                        "kelvin_shear_moduli": [1e5],
+                        "kelvin_viscosities": [1.1e4],
+                    },
+                    "adhesion": {"work_of_adhesion": 0.05, "interaction_range": 3e-6},
+                    "numerics": {"preset": "fast"},
+                },
+            }
+        ).contact("c"),
         "punch": one_contact(
             {"shape": "flat_punch", "radius": 5e-4},
             kelvin=[1e5],
@@ -130,6 +147,7 @@ def depth_scale(name: str) -> float:
         "two_kelvin": 25e-6,
         "growing": 30e-6,
         "cone": 20e-6,
+        "loose_range": 30e-6,
         "punch": 2e-6,
     }[name]
 
