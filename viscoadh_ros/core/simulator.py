@@ -503,11 +503,13 @@ class _TimeStepped:
 
     # -- model interface ----------------------------------------------------------------
     def advance(self, d0: float, d1: float, dt: float) -> tuple[float, float, float]:
-        if not self._ensure_row(max(d0, d1)):
-            self.substeps = 0
-            return 0.0, 0.0, 0.0
-        assert self.row is not None
         row = self.row
+        if row is None:
+            if not self._ensure_row(max(d0, d1)):
+                self.substeps = 0
+                return 0.0, 0.0, 0.0
+            row = self.row
+            assert row is not None
         # The first kernel call of the transaction on this row journals its memory into the
         # row's `txn` buffers (inside the compiled call, before the kernel writes anything)
         # instead of a snapshot of numpy copies. `_journal` is set just before that call: no
@@ -802,10 +804,6 @@ def _modal_chain(e0: float, e_kelvin: np.ndarray, eta_kelvin: np.ndarray) -> tup
     return p, p_inv, np.ascontiguousarray(lam), beta
 
 
-class _NeedsGeneralPath(Exception):
-    """`_step_lean` found a step the general path must take (the state is already restored)."""
-
-
 @dataclass(frozen=True)
 class Snapshot:
     """An opaque copy of a simulator's state (see `ContactSimulator.snapshot`)."""
@@ -933,8 +931,8 @@ class ContactSimulator:
         (`force`, N); exactly one of them. Returns the new StepOutput. On any error the
         state is left as it was before the call."""
         # The common case (a finite float depth at a finite float time not before the last,
-        # on the time-stepped model with a domain) takes the lean path: the same outputs and
-        # the same transaction in about a fifth of the Python (tests/test_step_lean.py).
+        # on the time-stepped model) takes the lean path: the same outputs and the same
+        # transaction with a fraction of the Python (tests/test_step_lean.py).
         if force is None and self._lean and isinstance(depth, float) and isinstance(time, float):
             t = float(time)
             d = float(depth)
@@ -946,7 +944,20 @@ class ContactSimulator:
 
     def _step_transaction(self, time: float, depth: float | None, force: float | None) -> StepOutput:
         """`step` on the general path: validation, then `_step` as a transaction."""
-        saved = (
+        saved = self._undo_token()
+        try:
+            return self._step(time, depth, force)
+        except BaseException:
+            self._undo(saved)
+            raise
+
+    def _undo_token(self) -> tuple:
+        """Begin a transaction: the token `_undo` takes to bring back the state of now, either
+        from inside the next step (its rollback) or after it succeeded (`core.hand` undoes the
+        contacts of a sample that stepped before a failing one). No copies: the memory comes
+        back from the journal the step's first kernel call writes (`_TimeStepped.begin`). Valid
+        until the simulator's next step or restore."""
+        return (
             self._model.begin(),
             self._time,
             self._depth,
@@ -954,12 +965,11 @@ class ContactSimulator:
             self._energy_input,
             self._held_force,
         )
-        try:
-            return self._step(time, depth, force)
-        except BaseException:
-            self._model.rollback(saved[0])
-            self._time, self._depth, self._output, self._energy_input, self._held_force = saved[1:]
-            raise
+
+    def _undo(self, token: tuple) -> None:
+        """Back to the state `_undo_token` saw (see there)."""
+        self._model.rollback(token[0])
+        self._time, self._depth, self._output, self._energy_input, self._held_force = token[1:]
 
     def _step(self, time: float, depth: float | None, force: float | None) -> StepOutput:
         t = self._check_time(time)
@@ -977,100 +987,67 @@ class ContactSimulator:
 
     def _step_lean(self, t: float, d: float) -> StepOutput | None:
         """`step(t, depth=d)` for a finite `d` at a finite `t` >= `time` on the time-stepped
-        model: one compiled call (`_kernels._advance_packed`, which also journals the memory)
-        and the output built from the kernel's slots, as `_move` / `_TimeStepped.advance` /
-        `_make_output` would, bit for bit. None (nothing changed) when the general path must
-        take the step: no domain yet, an idle contact above the surface, or a contact that
-        needs a larger domain. On any exception the state is restored as the transaction of
-        the general path restores it."""
+        model: `_step` / `_move` / `_publish` / `_make_output` in one frame, the edge outputs
+        read from the kernel's (`edge_height` and `edge_gaps` return the same values after an
+        advance), bit for bit the general path's output and state. None (nothing changed)
+        for an idle contact above the surface (the general path drops its memory). On any
+        exception the state is restored as the general path's transaction restores it."""
         model = self._model
-        row = model.row
-        if row is None:
-            return None
         d_prev = self._depth
         output0 = self._output
         r0 = output0.contact_radius
         if d < 0.0 and d_prev < 0.0 and r0 <= 0.0 and model.is_relaxed():
-            return None  # idle above the surface: the general path drops the memory
+            return None
         time0 = self._time
-        radius0 = model.radius
-        dissipated0 = model.dissipated
-        peak0, edge0, edge_depth0 = model._memory_peak, model._edge, model._edge_depth
         energy0 = self._energy_input
         held0 = self._held_force
-        journal0 = model._journal
-        dt = t - time0
-        numerics = self.numerics
-        # The journal is valid once the call returned (it copies before the kernel writes).
-        model._journal = row
-        status = _kernels._advance_packed(
-            row._state,
-            row._const,
-            True,
-            radius0,
-            d_prev,
-            d,
-            dt,
-            numerics.max_substep,
-            numerics.max_edge_cells * row.dx,
-        )
+        token = model.begin()
         try:
-            if status != _kernels.STATUS_OK:
-                raise _NeedsGeneralPath
-            radius, force, work, _, substeps, lost, peak, outside, inside, g_edge = row.out.tolist()
-            dissipated = dissipated0 + lost
+            dt = t - time0
+            radius, force, work = model.advance(d_prev, d, dt)
             energy = energy0 + work
-            # `_make_output` with the kernel's edge outputs (`edge_height`, `edge_gaps` read
-            # the same slots after an advance).
             physics = self.physics
-            g_at = g_edge if radius > 0.0 else 0.0
             if radius <= 0.0:
                 phase = _NO_CONTACT
-            elif radius > r0:
-                phase = _INDENTING
-            elif radius < r0:
-                phase = _DETACHING
+                g_edge = 0.0
             else:
-                tol = 1e-9 * (abs(d) + physics.c_crit * math.sqrt(radius) + g_at)
-                if outside >= -tol:
+                outside, inside, g_edge = model._edge
+                if radius > r0:
                     phase = _INDENTING
-                elif inside <= tol:
+                elif radius < r0:
                     phase = _DETACHING
                 else:
-                    phase = _STICKING
+                    tol = 1e-9 * (abs(d) + physics.c_crit * math.sqrt(radius) + g_edge)
+                    if outside >= -tol:
+                        phase = _INDENTING
+                    elif inside <= tol:
+                        phase = _DETACHING
+                    else:
+                        phase = _STICKING
             edge_speed = (radius - r0) / dt if dt > 0.0 else 0.0
-            u = d - g_at
-            effective = (
-                physics.e_relaxed * u * u / (2.0 * math.pi * radius) if radius > 0.0 and u < 0.0 else 0.0
-            )
+            u = d - g_edge
+            if radius > 0.0 and u < 0.0:
+                effective = physics.e_relaxed * u * u / (2.0 * math.pi * radius)
+            else:
+                effective = 0.0
             if edge_speed == 0.0:
                 separated = True
             else:
                 v_c1, v_c2 = physics.critical_speeds
                 separated = abs(edge_speed) >= (v_c1 if edge_speed > 0.0 else v_c2)
             output = _new_output(
-                t, d, force, radius, phase, edge_speed, effective, energy, dissipated, separated, False
+                t, d, force, radius, phase, edge_speed, effective, energy, model.dissipated, separated, False
             )
-            model.radius = radius
-            model.substeps = int(substeps)
-            model.dissipated = dissipated
-            model._memory_peak = peak
-            model._edge = (outside, inside, g_edge)
-            model._edge_depth = d
             self._energy_input = energy
             self._time = t
             self._depth = d
             self._output = output
             self._held_force = None
             return output
-        except BaseException as error:
-            _kernels._restore_state(row.wl, row.wsum, row.wb, row.bsum, row.txn, row.txn_b)
-            model.radius, model.dissipated, model._journal = radius0, dissipated0, journal0
-            model._memory_peak, model._edge, model._edge_depth = peak0, edge0, edge_depth0
+        except BaseException:
+            model.rollback(token)
             self._energy_input, self._time, self._depth = energy0, time0, d_prev
             self._output, self._held_force = output0, held0
-            if isinstance(error, _NeedsGeneralPath):
-                return None
             raise
 
     def advance(self, time: float) -> StepOutput:
