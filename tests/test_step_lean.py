@@ -110,16 +110,17 @@ def test_an_interrupt_inside_the_lean_step_changes_nothing(monkeypatch: pytest.M
         reference.step(k * 1e-3, depth=scale * 0.03 * k)
     assert sim._model.row is not None and sim.in_contact
     before = _state(sim)
-    real = simulator._new_output
+    real = simulator._object_new
 
     def interrupted(*args):
         raise _Interrupt
 
-    monkeypatch.setattr(simulator, "_new_output", interrupted)
+    # After the kernel ran (the output record is the step's last work before it commits).
+    monkeypatch.setattr(simulator, "_object_new", interrupted)
     with pytest.raises(_Interrupt):
         sim.step(40e-3, depth=scale * 1.3)
     assert _state(sim) == before
-    monkeypatch.setattr(simulator, "_new_output", real)
+    monkeypatch.setattr(simulator, "_object_new", real)
     for k in range(40, 60):
         assert sim.step(k * 1e-3, depth=scale * 0.02 * (80 - k)) == reference.step(
             k * 1e-3, depth=scale * 0.02 * (80 - k)
