@@ -6,8 +6,9 @@ process, against the bench's minimal stepper (issue 13, the Python step path).
 The old checkout's `viscoadh_ros/core` is copied into a temporary package (`_old_core`), so both
 simulators run in this interpreter on the same scene (the kernel section's standard solid,
 pressed then cycled in contact at 1 kHz, `bench.kernel.measure_kernel`'s setup), interleaved
-repeat by repeat (median of repeats): old step, new step, the minimal stepper's step, and
-the old/new `core.hand.step_contacts` per contact. Only the ratios of one run mean anything
+repeat by repeat (median of repeats): old step, new step, the minimal stepper's step, where
+the new step's time goes (Python, dispatch, kernel), and the old/new
+`core.hand.step_contacts` per contact. Only the ratios of one run mean anything
 on a shared machine.
 """
 
@@ -23,9 +24,10 @@ from pathlib import Path
 import numpy as np
 
 from viscoadh_ros.bench.accuracy import Case, cases, contact_config
-from viscoadh_ros.bench.kernel import DEPTH_HIGH, DEPTH_LOW, STEP_S, _cycle, kelvin_material
+from viscoadh_ros.bench.kernel import DEPTH_HIGH, DEPTH_LOW, STEP_S, _cycle, _kernel_steps, kelvin_material
 from viscoadh_ros.bench.reference_stepper import MinimalStepper
 from viscoadh_ros.bench.timing import interleaved_medians
+from viscoadh_ros.core import _kernels
 from viscoadh_ros.core import hand as new_hand
 from viscoadh_ros.core.simulator import ContactSimulator
 
@@ -109,6 +111,47 @@ def per_call(old_sim_module, elements: int, kelvin: int, repeats: int) -> dict[s
     return {name: value / CALLS * 1e6 for name, value in medians.items()}
 
 
+def split(elements: int, kelvin: int, repeats: int) -> dict[str, float]:
+    """Where the new step's time goes, us per call: the whole `step`, the packed kernel call
+    from Python alone (`_advance_packed`, journal included) and the kernel looped in compiled
+    code (`bench.kernel._kernel_steps`: no dispatch)."""
+    case, contact = contact_for(elements, kelvin)
+    depth = _cycle(case, CALLS)
+    sim = pressed(ContactSimulator, contact, case.depth_scale)
+    start = sim.snapshot()
+    row = sim._model.row
+    wl0, wb0 = row.memory()
+    radius = sim._model.radius
+    times = [sim.time + i * STEP_S for i in range(1, CALLS + 1)]
+    depths = [float(x) for x in depth[1:]]
+    max_substep = sim.numerics.max_substep
+    max_edge_move = sim.numerics.max_edge_cells * row.dx
+
+    def steps() -> None:
+        sim.restore(start)
+        for t, d in zip(times, depths, strict=True):
+            sim.step(t, depth=d)
+
+    def packed() -> None:
+        row.set_memory(wl0, wb0)
+        a, previous, out = radius, float(depth[0]), row.out
+        for d in depths:
+            _kernels._advance_packed(
+                row._state, row._const, True, a, previous, d, STEP_S, max_substep, max_edge_move
+            )
+            a, previous = float(out[0]), d
+
+    def compiled() -> None:
+        row.set_memory(wl0, wb0)
+        _kernel_steps(row.kernel_args, radius, depth, STEP_S, max_substep, max_edge_move)
+
+    runs = {"step": steps, "packed": packed, "compiled": compiled}
+    for fn in runs.values():
+        fn()
+    medians = interleaved_medians(runs, repeats=repeats)
+    return {name: value / CALLS * 1e6 for name, value in medians.items()}
+
+
 def per_hand(old_sim_module, old_hand, count: int, repeats: int) -> dict[str, float]:
     """`step_contacts` on `count` default-scene-like contacts (N = 160, K = 1), per contact."""
     case, contact = contact_for(160, 1)
@@ -158,6 +201,16 @@ def main() -> None:
             print(
                 f"| {elements} | {kelvin} | {r['old']:.2f} | {r['new']:.2f} | {r['minimal']:.2f} | "
                 f"{r['old'] / r['new']:.2f} | {r['new'] / r['minimal']:.2f} |"
+            )
+    print("\nwhere the new step's time goes, us per call (same stretch)")
+    print("| N | K | step() | packed kernel call | kernel in a compiled loop | Python | dispatch |")
+    print("|---|---|---|---|---|---|---|")
+    for kelvin in (int(k) for k in args.kelvin.split(",")):
+        for elements in (int(n) for n in args.elements.split(",")):
+            r = split(elements, kelvin, args.repeats)
+            print(
+                f"| {elements} | {kelvin} | {r['step']:.2f} | {r['packed']:.2f} | {r['compiled']:.2f} | "
+                f"{r['step'] - r['packed']:.2f} | {r['packed'] - r['compiled']:.2f} |"
             )
     if args.hand:
         print("\nstep_contacts per contact, us (N = 160, K = 1, in contact)")

@@ -837,7 +837,7 @@ class ContactSimulator:
             self._model: _ClosedForm | _TimeStepped = _ClosedForm(self.physics)
         else:
             self._model = _TimeStepped(self.physics, self.numerics)
-        # Depth steps may take `_step_lean` (the time-stepped model only).
+        # Depth steps may take the lean path in `step` (the time-stepped model only).
         self._lean = isinstance(self._model, _TimeStepped)
         self.reset(0.0)
 
@@ -933,16 +933,90 @@ class ContactSimulator:
         """Advance to `time` (s) under displacement control (`depth`, m) or force control
         (`force`, N); exactly one of them. Returns the new StepOutput. On any error the
         state is left as it was before the call."""
-        # The common case (a finite float depth at a finite float time not before the last,
-        # on the time-stepped model) takes the lean path: the same outputs and the same
-        # transaction with a fraction of the Python (tests/test_step_lean.py).
+        # The lean path, for the common case: a finite float depth at a finite float time not
+        # before the last, on the time-stepped model, not idle above the surface (the general
+        # path drops that memory). It is `_step` / `_move` / `_publish` / `_make_output` in
+        # this one frame, the edge outputs read from the kernel's (`edge_height` and
+        # `edge_gaps` return the same values after an advance): the general path's outputs and
+        # state bit for bit, and its transaction (tests/test_step_lean.py).
         if force is None and self._lean and isinstance(depth, float) and isinstance(time, float):
             t = time if type(time) is float else float(time)
             d = depth if type(depth) is float else float(depth)
-            if t - t == 0.0 and d - d == 0.0 and t >= self._time:
-                output = self._step_lean(t, d)
-                if output is not None:
+            model = self._model
+            d_prev = self._depth
+            output0 = self._output
+            r0 = output0.contact_radius
+            time0 = self._time
+            if (
+                t - t == 0.0
+                and d - d == 0.0
+                and t >= time0
+                and not (d < 0.0 and d_prev < 0.0 and r0 <= 0.0 and model.is_relaxed())
+            ):
+                energy0 = self._energy_input
+                held0 = self._held_force
+                token = model.begin()
+                try:
+                    dt = t - time0
+                    radius, f, work = model.advance(d_prev, d, dt)
+                    energy = energy0 + work
+                    physics = self.physics
+                    if radius <= 0.0:
+                        phase = _NO_CONTACT
+                        g_edge = 0.0
+                    else:
+                        outside, inside, g_edge = model._edge
+                        if radius > r0:
+                            phase = _INDENTING
+                        elif radius < r0:
+                            phase = _DETACHING
+                        else:
+                            tol = 1e-9 * (abs(d) + physics.c_crit * math.sqrt(radius) + g_edge)
+                            if outside >= -tol:
+                                phase = _INDENTING
+                            elif inside <= tol:
+                                phase = _DETACHING
+                            else:
+                                phase = _STICKING
+                    edge_speed = (radius - r0) / dt if dt > 0.0 else 0.0
+                    u = d - g_edge
+                    if radius > 0.0 and u < 0.0:
+                        effective = physics.e_relaxed * u * u / (2.0 * math.pi * radius)
+                    else:
+                        effective = 0.0
+                    if edge_speed == 0.0:
+                        separated = True
+                    else:
+                        v_c1, v_c2 = physics.critical_speeds
+                        separated = abs(edge_speed) >= (v_c1 if edge_speed > 0.0 else v_c2)
+                    # `_new_output` inline (a call with 11 arguments is ~0.1 us of this path).
+                    output = _object_new(StepOutput)
+                    output.__dict__.update(
+                        {
+                            "time": t,
+                            "depth": d,
+                            "force": f,
+                            "contact_radius": radius,
+                            "phase": phase,
+                            "edge_speed": edge_speed,
+                            "effective_work_of_adhesion": effective,
+                            "energy_input": energy,
+                            "energy_dissipated": model.dissipated,
+                            "scale_separation_ok": separated,
+                            "unstable": False,
+                        }
+                    )
+                    self._energy_input = energy
+                    self._time = t
+                    self._depth = d
+                    self._output = output
+                    self._held_force = None
                     return output
+                except BaseException:
+                    model.rollback(token)
+                    self._energy_input, self._time, self._depth = energy0, time0, d_prev
+                    self._output, self._held_force = output0, held0
+                    raise
         return self._step_transaction(time, depth, force)
 
     def _step_transaction(self, time: float, depth: float | None, force: float | None) -> StepOutput:
@@ -987,85 +1061,6 @@ class ContactSimulator:
         output = self._solve_force(t, target)
         self._held_force = target
         return output
-
-    def _step_lean(self, t: float, d: float) -> StepOutput | None:
-        """`step(t, depth=d)` for a finite `d` at a finite `t` >= `time` on the time-stepped
-        model: `_step` / `_move` / `_publish` / `_make_output` in one frame, the edge outputs
-        read from the kernel's (`edge_height` and `edge_gaps` return the same values after an
-        advance), bit for bit the general path's output and state. None (nothing changed)
-        for an idle contact above the surface (the general path drops its memory). On any
-        exception the state is restored as the general path's transaction restores it."""
-        model = self._model
-        d_prev = self._depth
-        output0 = self._output
-        r0 = output0.contact_radius
-        if d < 0.0 and d_prev < 0.0 and r0 <= 0.0 and model.is_relaxed():
-            return None
-        time0 = self._time
-        energy0 = self._energy_input
-        held0 = self._held_force
-        token = model.begin()
-        try:
-            dt = t - time0
-            radius, force, work = model.advance(d_prev, d, dt)
-            energy = energy0 + work
-            physics = self.physics
-            if radius <= 0.0:
-                phase = _NO_CONTACT
-                g_edge = 0.0
-            else:
-                outside, inside, g_edge = model._edge
-                if radius > r0:
-                    phase = _INDENTING
-                elif radius < r0:
-                    phase = _DETACHING
-                else:
-                    tol = 1e-9 * (abs(d) + physics.c_crit * math.sqrt(radius) + g_edge)
-                    if outside >= -tol:
-                        phase = _INDENTING
-                    elif inside <= tol:
-                        phase = _DETACHING
-                    else:
-                        phase = _STICKING
-            edge_speed = (radius - r0) / dt if dt > 0.0 else 0.0
-            u = d - g_edge
-            if radius > 0.0 and u < 0.0:
-                effective = physics.e_relaxed * u * u / (2.0 * math.pi * radius)
-            else:
-                effective = 0.0
-            if edge_speed == 0.0:
-                separated = True
-            else:
-                v_c1, v_c2 = physics.critical_speeds
-                separated = abs(edge_speed) >= (v_c1 if edge_speed > 0.0 else v_c2)
-            # `_new_output` inline (a call with 11 arguments is ~0.1 us of this path).
-            output = _object_new(StepOutput)
-            output.__dict__.update(
-                {
-                    "time": t,
-                    "depth": d,
-                    "force": force,
-                    "contact_radius": radius,
-                    "phase": phase,
-                    "edge_speed": edge_speed,
-                    "effective_work_of_adhesion": effective,
-                    "energy_input": energy,
-                    "energy_dissipated": model.dissipated,
-                    "scale_separation_ok": separated,
-                    "unstable": False,
-                }
-            )
-            self._energy_input = energy
-            self._time = t
-            self._depth = d
-            self._output = output
-            self._held_force = None
-            return output
-        except BaseException:
-            model.rollback(token)
-            self._energy_input, self._time, self._depth = energy0, time0, d_prev
-            self._output, self._held_force = output0, held0
-            raise
 
     def advance(self, time: float) -> StepOutput:
         """Hold the last control until `time` (s): the last commanded force under force
@@ -1197,7 +1192,7 @@ class ContactSimulator:
             phase = _DETACHING
         else:
             # Pinned edge: say which criterion it rests on, if any (elastic contacts at
-            # rest sit on both; a punch rim blocks attachment). `_step_lean` repeats this.
+            # rest sit on both; a punch rim blocks attachment). `step`'s lean path repeats this.
             tol = 1e-9 * (abs(depth) + physics.c_crit * math.sqrt(radius) + g_edge)
             outside, inside = self._model.edge_gaps(depth)
             if outside >= -tol:
