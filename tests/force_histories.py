@@ -35,9 +35,7 @@ def finger_contact() -> Any:
 
 def elastic_contact() -> Any:
     """Elastic JKR sphere on the time-stepped path (no memory: only adhesion)."""
-    return one_contact(
-        {"shape": "sphere", "radius": 1e-3}, work=0.05, numerics={"model": "time_stepped"}
-    )
+    return one_contact({"shape": "sphere", "radius": 1e-3}, work=0.05, numerics={"model": "time_stepped"})
 
 
 def two_kelvin_cone() -> Any:

@@ -850,8 +850,9 @@ class ContactSimulator:
         self._energy_input = 0.0
         self._held_force: float | None = None
         # What the next force step predicts its root from (`_remember`): (the output it
-        # belongs to, slope dF/dd N/m, drift dF/dt at a held depth N/s), or None.
-        self._force_memo: tuple[StepOutput, float, float] | None = None
+        # belongs to, slope dF/dd N/m, drift dF/dt at a held depth N/s, the slope's change
+        # along the path N/m^2), or None.
+        self._force_memo: tuple[StepOutput, float, float, float] | None = None
         self._model.reset()
         self._output = StepOutput(
             self._time, 0.0, 0.0, 0.0, Phase.NO_CONTACT, 0.0, 0.0, 0.0, 0.0, True, False
@@ -1118,7 +1119,8 @@ class ContactSimulator:
         model = self._model
         start = model.get_state()
         d0 = self._depth
-        f0 = self._output.force
+        before = self._output
+        f0 = before.force
         dt = time - self._time
         tol = self.numerics.force_tolerance * max(abs(target), abs(f0), 1e-300)
         stop = self._force_stop(target, self._output.contact_radius)
@@ -1137,12 +1139,14 @@ class ContactSimulator:
 
         memo = self._force_memo
         if memo is not None and memo[0] is self._output and was_in_contact:
-            slope, drift_rate = memo[1], memo[2]
-            root = self._predicted_root(residual, d0 + (target - f0 - drift_rate * dt) / slope, slope, stop)
+            slope, drift_rate, bend = memo[1], memo[2], memo[3]
+            # F(d) ~ F(d0) + slope (d - d0), F(d0) ~ f0 + drift_rate dt.
+            first = d0 + (target - f0 - drift_rate * dt) / slope
+            root = self._predicted_root(residual, d0, first, slope, bend, stop)
             if root is not None:
                 # The model is in the state of the trial at the root: publish it as it stands.
                 output = self._publish(time, root, last[1], unstable=False)
-                self._remember(output, trials, d0, f0, dt, None, slope)
+                self._remember(output, before, trials, d0, f0, dt, None, slope)
                 return output
             trials.clear()
 
@@ -1200,15 +1204,18 @@ class ContactSimulator:
         unstable = abs(r_root) > max(tol, stop, 1e-9 * abs(target)) or jumped_in
         # The model is in the state of the trial at the root: publish it (no second trial).
         output = self._publish(time, root, last[1], unstable=unstable)
-        self._remember(output, trials, d0, f0, dt, hold_force, None)
+        self._remember(output, before, trials, d0, f0, dt, hold_force, None)
         return output
 
     #: Trials of the predicted secant before it gives way to the bracketing search.
     PREDICTED_TRIALS = 4
 
-    def _predicted_root(self, residual, first: float, slope: float, stop: float) -> float | None:
-        """Secant steps from the predicted depth `first` (m) with the last step's slope
-        `slope` (N/m); the depth of the trial within `stop` (N) of the target (the model left
+    def _predicted_root(
+        self, residual, d0: float, first: float, slope: float, bend: float, stop: float
+    ) -> float | None:
+        """Secant steps from the predicted depth `first` (m), the first with the last step's
+        slope `slope` (N/m) carried to `first` by its change along the path `bend` (N/m^2)
+        from the held depth `d0`; the depth of the trial within `stop` (N) of the target (the model left
         in its state), or None when a trial detaches, a secant slope is not within a factor 4
         of `slope` (the force-depth curve bends: a fold or a jump is near, which the
         bracketing search handles) or PREDICTED_TRIALS trials did not converge."""
@@ -1216,10 +1223,13 @@ class ContactSimulator:
         r = residual(x)
         if not self._attached():
             return None
+        tangent = slope + bend * (first - d0)
+        if not 0.5 * slope < tangent < 2.0 * slope:
+            tangent = slope
         for _ in range(self.PREDICTED_TRIALS - 1):
             if abs(r) <= stop:
                 return x
-            x_new = x - r / slope
+            x_new = x - r / tangent
             if x_new == x:
                 return None
             r_new = residual(x_new)
@@ -1228,12 +1238,13 @@ class ContactSimulator:
             secant = (r_new - r) / (x_new - x)
             if not 0.25 * slope <= secant <= 4.0 * slope:
                 return None
-            x, r, slope = x_new, r_new, secant
+            x, r, tangent = x_new, r_new, secant
         return x if abs(r) <= stop else None
 
     def _remember(
         self,
         output: StepOutput,
+        before: StepOutput,
         trials: list[tuple[float, float, float]],
         d0: float,
         f0: float,
@@ -1242,9 +1253,14 @@ class ContactSimulator:
         slope: float | None,
     ) -> None:
         """Keep what the next force step predicts its root from: the slope dF/dd at the root
-        (from the trial nearest it, else `slope`) and the rate at which the force drifts at a
-        held depth (from `hold_force`, the trial at the held depth d0, else extrapolated along
-        the slope), tied to `output` (stale once the simulator's output is another)."""
+        (from the trial nearest it, else `slope`), its change along the path since the step
+        that ended in `before` (the output before this step), and the rate at which the force
+        drifts at a held depth (from `hold_force`, the trial at the held depth d0, else
+        extrapolated along the slope), tied to `output` (stale once the simulator's output
+        is another)."""
+        previous = self._force_memo
+        if previous is not None and previous[0] is not before:
+            previous = None
         self._force_memo = None
         root = output.depth
         if output.unstable or output.contact_radius <= 0.0:
@@ -1261,8 +1277,12 @@ class ContactSimulator:
         if hold_force is None:
             hold_force = output.force + slope * (d0 - root)
         drift_rate = (hold_force - f0) / dt if dt > 0.0 else 0.0
-        if math.isfinite(drift_rate):
-            self._force_memo = (output, slope, drift_rate)
+        # The slope's change along the path, from the last step's slope if it left one.
+        bend = 0.0
+        if previous is not None and root != d0:
+            bend = (slope - previous[1]) / (root - d0)
+        if math.isfinite(drift_rate) and math.isfinite(bend):
+            self._force_memo = (output, slope, drift_rate, bend)
 
     def _search_dip(
         self,
