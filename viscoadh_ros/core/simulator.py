@@ -1183,7 +1183,7 @@ class ContactSimulator:
             if detached:
                 found, boundary = self._search_dip(residual, trials, target, stop)
                 if found is None:
-                    return self._pulled_off(boundary, time, start)
+                    return self._pulled_off(boundary, time, start, last)
                 lo, r_lo, hi, r_hi = found
                 break
             lo, r_lo = hi, r_hi
@@ -1379,10 +1379,13 @@ class ContactSimulator:
         lo, r_lo = min((d, f - target) for d, f, _ in trials if d > dip and f - target > 0.0)
         return lo, r_lo, dip, r_dip
 
-    def _pulled_off(self, detached: float, time: float, start: Any) -> StepOutput:
+    def _pulled_off(self, detached: float, time: float, start: Any, last: list[Any]) -> StepOutput:
         """No equilibrium under force control: move to the detached state at the depth where
         the contact let go (`detached`, m, from `_search_dip`), flagged unstable; `start`:
-        the model's state before the step."""
-        self._model.rewind(start)
+        the model's state before the step; `last`: the depth of the last trial and its
+        result (when that trial was at `detached`, the model is in that state already)."""
         self._force_memo = None
+        if last[0] == detached:
+            return self._publish(time, detached, last[1], unstable=True)
+        self._model.rewind(start)
         return self._move(time, detached, unstable=True)
