@@ -1214,11 +1214,12 @@ class ContactSimulator:
         self, residual, d0: float, first: float, slope: float, bend: float, stop: float
     ) -> float | None:
         """Secant steps from the predicted depth `first` (m), the first with the last step's
-        slope `slope` (N/m) carried to `first` by its change along the path `bend` (N/m^2)
-        from the held depth `d0`; the depth of the trial within `stop` (N) of the target (the model left
-        in its state), or None when a trial detaches, a secant slope is not within a factor 4
-        of `slope` (the force-depth curve bends: a fold or a jump is near, which the
-        bracketing search handles) or PREDICTED_TRIALS trials did not converge."""
+        slope `slope` (N/m) carried from the held depth `d0` to `first` by its change along
+        the path `bend` (N/m^2). Returns the depth of the trial within `stop` (N) of the
+        target (the model left in its state), or None when a trial detaches, a secant slope
+        is not within a factor 4 of `slope` (the force-depth curve bends: a fold or a jump is
+        near, which the bracketing search handles) or PREDICTED_TRIALS trials did not
+        converge."""
         x = first
         r = residual(x)
         if not self._attached():
@@ -1373,8 +1374,8 @@ class ContactSimulator:
         trials: list[tuple[float, float, float]], target: float, dip: float, r_dip: float
     ) -> tuple[float, float, float, float]:
         """The bracket (lo, r_lo, dip, r_dip) of the root between the attached trial `dip`
-        (force at or below the target) and the nearest attached trial on the held depth's
-        side (larger depth: the search pulls) whose force is above it (the held depth's
+        (force at or below the target) and the nearest trial on the held depth's side
+        (larger depth: the search pulls) whose force is above the target (the held depth's
         trial is one)."""
         lo, r_lo = min((d, f - target) for d, f, _ in trials if d > dip and f - target > 0.0)
         return lo, r_lo, dip, r_dip
