@@ -1169,6 +1169,10 @@ class ContactSimulator:
         stiffness = self._stiffness_guess()
         if self._output.contact_radius > 0.0:
             stiffness *= self.physics.e0 / self.physics.e_relaxed
+        elif model.radius > 0.0:
+            # Out of contact, but the held depth touched (snap-in, or the surface crept back):
+            # the glass stiffness of the contact that formed.
+            stiffness = 2.0 * self.physics.e0 * model.radius
         delta = max(abs(r_hold) / stiffness, 1e-12 * (abs(d0) + 1e-12))
         lo, r_lo = d0, r_hold
         # Pulled to a zero force, an adhesive contact holds it before it lets go; a detached
