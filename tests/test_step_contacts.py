@@ -65,7 +65,17 @@ def test_bad_shapes_and_modes_are_refused_before_any_step() -> None:
 def _full_state(sim: ContactSimulator) -> tuple:
     state = sim.snapshot().model_state
     memory = b"" if state[2] is None else state[2].tobytes() + state[3].tobytes()
-    return (sim.time, sim.output, sim._energy_input, sim._held_force, state[0], state[1], state[4], memory)
+    return (
+        sim.time,
+        sim.output,
+        sim._energy_input,
+        sim._held_force,
+        sim._force_memo,
+        state[0],
+        state[1],
+        state[4],
+        memory,
+    )
 
 
 @pytest.mark.parametrize("mode", [DEPTH, FORCE])
@@ -84,9 +94,11 @@ def test_undone_contacts_go_on_exactly_as_if_the_sample_never_came(mode: int) ->
         step_contacts(sims, [3e-3, 3e-3, 1e-3], mode, values)
     assert raised.value.index == 2
     assert [_full_state(s) for s in sims] == before
-    for t, depth in ((4e-3, 2e-5), (5e-3, -1e-5), (6e-3, 5e-5)):
-        assert step_contacts(sims, [t] * 3, DEPTH, [depth] * 3) == [s.step(t, depth=depth) for s in alone]
-    assert [_full_state(s)[7] for s in sims] == [_full_state(s)[7] for s in alone]
+    for t, value in ((4e-3, 2e-5), (5e-3, -1e-5), (6e-3, 5e-5)):
+        assert step_contacts(sims, [t] * 3, DEPTH, [value] * 3) == [s.step(t, depth=value) for s in alone]
+    for t, value in ((7e-3, 1e-3), (8e-3, 2e-3), (9e-3, 1e-3)):
+        assert step_contacts(sims, [t] * 3, FORCE, [value] * 3) == [s.step(t, force=value) for s in alone]
+    assert [_full_state(s)[8] for s in sims] == [_full_state(s)[8] for s in alone]
 
 
 def test_a_simulator_listed_twice_is_refused() -> None:

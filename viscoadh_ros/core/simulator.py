@@ -817,6 +817,7 @@ class Snapshot:
     output: StepOutput
     energy_input: float
     held_force: float | None
+    force_memo: Any = None
 
 
 class ContactSimulator:
@@ -896,6 +897,10 @@ class ContactSimulator:
         self._depth = 0.0
         self._energy_input = 0.0
         self._held_force: float | None = None
+        # What the next force step predicts its root from (`_remember`): (the output it
+        # belongs to, slope dF/dd N/m, drift dF/dt at a held depth N/s, the slope's change
+        # along the path N/m^2), or None.
+        self._force_memo: tuple[StepOutput, float, float, float] | None = None
         self._model.reset()
         self._output = StepOutput(
             self._time, 0.0, 0.0, 0.0, Phase.NO_CONTACT, 0.0, 0.0, 0.0, 0.0, True, False
@@ -909,6 +914,7 @@ class ContactSimulator:
             self._output,
             self._energy_input,
             self._held_force,
+            self._force_memo,
         )
 
     def restore(self, snapshot: Snapshot) -> None:
@@ -918,6 +924,7 @@ class ContactSimulator:
         self._output = snapshot.output
         self._energy_input = snapshot.energy_input
         self._held_force = snapshot.held_force
+        self._force_memo = snapshot.force_memo
 
     # -- stepping -------------------------------------------------------------------------
     def _check_time(self, time: float) -> float:
@@ -1041,12 +1048,20 @@ class ContactSimulator:
             self._output,
             self._energy_input,
             self._held_force,
+            self._force_memo,
         )
 
     def _undo(self, token: tuple) -> None:
         """Back to the state `_undo_token` saw (see there)."""
         self._model.rollback(token[0])
-        self._time, self._depth, self._output, self._energy_input, self._held_force = token[1:]
+        (
+            self._time,
+            self._depth,
+            self._output,
+            self._energy_input,
+            self._held_force,
+            self._force_memo,
+        ) = token[1:]
 
     def _step(self, time: float, depth: float | None, force: float | None) -> StepOutput:
         t = self._check_time(time)
@@ -1238,35 +1253,69 @@ class ContactSimulator:
             )
         return 2.0 * self.physics.e_relaxed * radius
 
-    def _solve_force(self, time: float, target: float) -> StepOutput:
-        """Find the depth whose step from the current state gives `target` force (N)."""
-        start = self.snapshot()
-        d0 = self._depth
-        tol = self.numerics.force_tolerance * max(abs(target), abs(self._output.force), 1e-300)
-        # The root search stops within half the tolerance relative to the commanded force,
-        # floored at 1e-6 of the contact's adhesive force scale 2 E0* a dl_c(a) (the JKR
-        # adhesive term at the current radius): a zero force commanded to a contact in
-        # adhesive equilibrium is not chased down to 1e-300 N (44 trials per step).
-        radius = self._output.contact_radius
+    def _force_stop(self, target: float, radius: float) -> float:
+        """Where the root search stops, N: within half the force tolerance relative to the
+        commanded force, floored at 1e-6 of the contact's adhesive force scale 2 E0* a dl_c(a)
+        (the JKR adhesive term at the contact radius `radius`, m): a zero force commanded to a
+        contact in adhesive equilibrium is not chased down to 1e-300 N (44 trials per step)."""
         adhesive = 2.0 * self.physics.e0 * radius * self.physics.c_crit * math.sqrt(radius)
-        stop = 0.5 * self.numerics.force_tolerance * max(abs(target), 1e-6 * adhesive, 1e-300)
+        return 0.5 * self.numerics.force_tolerance * max(abs(target), 1e-6 * adhesive, 1e-300)
+
+    def _solve_force(self, time: float, target: float) -> StepOutput:
+        """Find the depth whose step from the current state gives `target` force (N).
+
+        Every trial is a full step of the model from the current state (rewound before each).
+        When the last step was a converged force step in contact, a secant predicted from it
+        (`_predicted_root`: its slope dF/dd and the force's drift at a held depth) usually
+        lands within the tolerance in one or two trials and is published as it stands; when
+        its checks fail (a trial detached, or a slope unlike the last one: near the fold of
+        the force-depth curve), the bracketing search from the held depth runs instead."""
+        # The model's state before the step (the simulator's own fields change only when the
+        # result is published): every trial but the first rewinds the model to it.
+        model = self._model
+        start = model.get_state()
+        d0 = self._depth
+        before = self._output
+        f0 = before.force
+        dt = time - self._time
+        tol = self.numerics.force_tolerance * max(abs(target), abs(f0), 1e-300)
+        stop = self._force_stop(target, self._output.contact_radius)
         was_in_contact = self.in_contact
 
-        model = self._model
         last: list[Any] = [None, None]  # depth of the last trial and its (radius, force, work)
+        trials: list[tuple[float, float, float]] = []  # (depth, force, radius) of every trial
 
         def residual(depth: float) -> float:
-            model.rewind(start.model_state)
+            if last[0] is not None:
+                model.rewind(start)
             result = self._trial(time, depth)
             last[0], last[1] = depth, result
+            trials.append((depth, result[1], result[0]))
             return result[1] - target
+
+        memo = self._force_memo
+        if memo is not None and memo[0] is self._output and was_in_contact:
+            slope, drift_rate, bend = memo[1], memo[2], memo[3]
+            # F(d) ~ F(d0) + slope (d - d0), F(d0) ~ f0 + drift_rate dt.
+            first = d0 + (target - f0 - drift_rate * dt) / slope
+            root = self._predicted_root(residual, d0, first, slope, bend, stop)
+            if root is not None:
+                # The model is in the state of the trial at the root: publish it as it stands.
+                output = self._publish(time, root, last[1], unstable=False)
+                self._remember(output, before, trials, d0, f0, dt, None, slope)
+                return output
+            trials.clear()
 
         r_hold = residual(d0)
         if abs(r_hold) <= tol:
-            return self._publish(time, d0, last[1], unstable=False)
+            output = self._publish(time, d0, last[1], unstable=False)
+            self._force_memo = None
+            return output
+        hold_force = r_hold + target
         direction = 1.0 if r_hold < 0.0 else -1.0
         if direction < 0.0 and not self._attached() and not was_in_contact:
             # Out of contact and pulled away: no equilibrium, the indenter stays off.
+            self._force_memo = None
             return self._publish(time, d0, last[1], unstable=target < 0.0)
         # First bracketing step: the Newton step on the contact's instantaneous (glass)
         # stiffness 2 E0* a, the stiffest the contact can answer, so the step falls short of
@@ -1276,41 +1325,200 @@ class ContactSimulator:
         stiffness = self._stiffness_guess()
         if self._output.contact_radius > 0.0:
             stiffness *= self.physics.e0 / self.physics.e_relaxed
+        elif model.radius > 0.0:
+            # Out of contact, but the held depth touched (snap-in, or the surface crept back):
+            # the glass stiffness of the contact that formed.
+            stiffness = 2.0 * self.physics.e0 * model.radius
         delta = max(abs(r_hold) / stiffness, 1e-12 * (abs(d0) + 1e-12))
         lo, r_lo = d0, r_hold
-        last_contact = d0
+        # Pulled to a zero force, an adhesive contact holds it before it lets go; a detached
+        # trial (zero force too) is no root then: look for the attached one.
+        adhesive = self.physics.work_of_adhesion > 0.0
         for _ in range(200):
             hi = lo + direction * delta
             r_hi = residual(hi)
-            if r_hi * direction >= 0.0:
+            detached = direction < 0.0 and not self._attached()
+            if r_hi * direction >= 0.0 and not (detached and r_hi == 0.0 and adhesive):
                 break
-            if direction < 0.0 and not self._attached():
-                found = self._search_dip(residual, hi, last_contact)
+            if detached:
+                found, boundary = self._search_dip(residual, trials, target, stop)
                 if found is None:
-                    return self._pulled_off(residual, hi, last_contact, time, start)
-                hi, r_hi = found
+                    return self._pulled_off(boundary, time, start, last)
+                lo, r_lo, hi, r_hi = found
                 break
-            last_contact = hi
             lo, r_lo = hi, r_hi
             delta *= 2.0
         else:
-            self.restore(start)
+            model.rewind(start)
             raise InputError(f"force {target!r} N cannot be reached from depth {d0!r} m")
+        if not was_in_contact and self._attached():
+            # Snapped in: the stop's floor from the contact that formed.
+            stop = max(stop, self._force_stop(target, model.radius))
         root, r_root = _bracketed_root(residual, lo, r_lo, hi, r_hi, stop)
         if last[0] != root:
             r_root = residual(root)
         jumped_in = not was_in_contact and self._attached() and self.physics.work_of_adhesion > 0.0
-        # A residual left at the root means the force jumped across the target (snap-in or
-        # a discontinuous edge): no continuous equilibrium path; keep the state reached.
-        unstable = abs(r_root) > max(tol, 1e-9 * abs(target)) or jumped_in
+        # A residual left at the root beyond where the search stops means the force jumped
+        # across the target (snap-in or a discontinuous edge): no continuous equilibrium
+        # path; keep the state reached.
+        unstable = abs(r_root) > max(tol, stop, 1e-9 * abs(target)) or jumped_in
         # The model is in the state of the trial at the root: publish it (no second trial).
-        return self._publish(time, root, last[1], unstable=unstable)
+        output = self._publish(time, root, last[1], unstable=unstable)
+        self._remember(output, before, trials, d0, f0, dt, hold_force, None)
+        return output
 
-    def _search_dip(self, residual, detached: float, attached: float) -> tuple[float, float] | None:
-        """Between an attached and a detached trial depth, look for a force below the target
-        that the bracketing step skipped (the minimum of F(d) lies before the fold)."""
-        lo, hi = detached, attached
+    #: Trials of the predicted secant before it gives way to the bracketing search.
+    PREDICTED_TRIALS = 4
+
+    def _predicted_root(
+        self, residual, d0: float, first: float, slope: float, bend: float, stop: float
+    ) -> float | None:
+        """Secant steps from the predicted depth `first` (m), the first with the last step's
+        slope `slope` (N/m) carried from the held depth `d0` to `first` by its change along
+        the path `bend` (N/m^2). Returns the depth of the trial within `stop` (N) of the
+        target (the model left in its state), or None when a trial detaches, a secant slope
+        is not within a factor 4 of `slope` (the force-depth curve bends: a fold or a jump is
+        near, which the bracketing search handles) or PREDICTED_TRIALS trials did not
+        converge."""
+        x = first
+        r = residual(x)
+        if not self._attached():
+            return None
+        tangent = slope + bend * (first - d0)
+        if not 0.5 * slope < tangent < 2.0 * slope:
+            tangent = slope
+        for _ in range(self.PREDICTED_TRIALS - 1):
+            if abs(r) <= stop:
+                return x
+            x_new = x - r / tangent
+            if x_new == x:
+                return None
+            r_new = residual(x_new)
+            if not self._attached():
+                return None
+            secant = (r_new - r) / (x_new - x)
+            if not 0.25 * slope <= secant <= 4.0 * slope:
+                return None
+            x, r, tangent = x_new, r_new, secant
+        return x if abs(r) <= stop else None
+
+    def _remember(
+        self,
+        output: StepOutput,
+        before: StepOutput,
+        trials: list[tuple[float, float, float]],
+        d0: float,
+        f0: float,
+        dt: float,
+        hold_force: float | None,
+        slope: float | None,
+    ) -> None:
+        """Keep what the next force step predicts its root from: the slope dF/dd at the root
+        (from the trial nearest it, else `slope`), its change along the path since the step
+        that ended in `before` (the output before this step), and the rate at which the force
+        drifts at a held depth (from `hold_force`, the trial at the held depth d0, else
+        extrapolated along the slope), tied to `output` (stale once the simulator's output
+        is another)."""
+        previous = self._force_memo
+        if previous is not None and previous[0] is not before:
+            previous = None
+        self._force_memo = None
+        root = output.depth
+        if output.unstable or output.contact_radius <= 0.0:
+            return
+        nearest = None
+        for depth, force, radius in trials:
+            closer = nearest is None or abs(depth - root) < abs(nearest[0] - root)
+            if radius > 0.0 and depth != root and closer:
+                nearest = (depth, force)
+        if nearest is not None:
+            slope = (output.force - nearest[1]) / (root - nearest[0])
+        if slope is None or not 0.0 < slope < math.inf:
+            return
+        if hold_force is None:
+            hold_force = output.force + slope * (d0 - root)
+        drift_rate = (hold_force - f0) / dt if dt > 0.0 else 0.0
+        # The slope's change along the path, from the last step's slope if it left one.
+        bend = 0.0
+        if previous is not None and root != d0:
+            bend = (slope - previous[1]) / (root - d0)
+        if math.isfinite(drift_rate) and math.isfinite(bend):
+            self._force_memo = (output, slope, drift_rate, bend)
+
+    def _search_dip(
+        self,
+        residual,
+        trials: list[tuple[float, float, float]],
+        target: float,
+        stop: float,
+    ) -> tuple[tuple[float, float, float, float] | None, float]:
+        """A pull's bracketing steps reached a detached trial with every attached trial above
+        the target: look for an attached force at or below the target between them (the
+        minimum of F(d) lies before the fold, and the steps may have skipped it). Returns
+        ((lo, r_lo, hi, r_hi): a bracket of the root nearest the held depth, or None) and,
+        when there is none, the depth (detached side) where the contact lets go.
+
+        The minimum is searched by golden section between the neighbours (by depth) of the
+        smallest attached trial, a detached point counting as above everything, and given up
+        once the smallest attached force found is above the target by more than the force can
+        drop within the bracket; only then is the detachment depth bisected, to 1e-13
+        relative or to where the force cannot move by more than `stop` (N) across the
+        interval. Both use the Lipschitz bound 2 x the glass stiffness 2 E0* a of the largest
+        contact tried (F(d) moves no faster under an instantaneous change of depth)."""
+        radius = max((r for _, _, r in trials), default=0.0)
+        lipschitz = 4.0 * self.physics.e0 * radius
+        samples = sorted(trials)
+        attached = [i for i, (_, _, r) in enumerate(samples) if r > 0.0]
+        if attached:
+            j = min(attached, key=lambda i: samples[i][1])
+            a = samples[max(j - 1, 0)][0]
+            b = samples[min(j + 1, len(samples) - 1)][0]
+            golden = 0.5 * (math.sqrt(5.0) - 1.0)
+
+            def value(x: float) -> float:
+                """The residual at x, +inf when detached (the minimum is attached)."""
+                r_x = residual(x)
+                return r_x if self._attached() else math.inf
+
+            c = b - golden * (b - a)
+            d = a + golden * (b - a)
+            rc = value(c)
+            if rc <= 0.0:
+                return self._dip_bracket(trials, target, c, rc), math.nan
+            rd = value(d)
+            if rd <= 0.0:
+                return self._dip_bracket(trials, target, d, rd), math.nan
+            # One new trial per iteration: the interior point that stays is reused.
+            for _ in range(120):
+                # c and d lie inside [a, b]: the smallest attached force in it is above the
+                # target unless it drops by more than the bound across the bracket.
+                inside = min(rc, rd)
+                if lipschitz * (b - a) < inside < math.inf:
+                    break
+                if abs(b - a) <= 1e-10 * max(abs(a), abs(b), 1e-300):
+                    break
+                if rc < rd:
+                    b, d, rd = d, c, rc
+                    c = b - golden * (b - a)
+                    rc = value(c)
+                    if rc <= 0.0:
+                        return self._dip_bracket(trials, target, c, rc), math.nan
+                else:
+                    a, c, rc = c, d, rd
+                    d = a + golden * (b - a)
+                    rd = value(d)
+                    if rd <= 0.0:
+                        return self._dip_bracket(trials, target, d, rd), math.nan
+        # No dip: bisect the detachment between the deepest detached trial shallower than
+        # every attached one and the shallowest attached trial.
+        hi = min((d for d, _, r in trials if r > 0.0), default=math.nan)
+        lo = max((d for d, _, r in trials if r <= 0.0 and d < hi), default=math.nan)
+        if not (math.isfinite(lo) and math.isfinite(hi)):
+            return None, min(d for d, _, r in trials if r <= 0.0)
+        width = stop / lipschitz if lipschitz > 0.0 else 0.0
         for _ in range(60):
+            if hi - lo <= max(1e-13 * max(abs(hi), abs(lo), 1e-300), width):
+                break
             mid = 0.5 * (lo + hi)
             r_mid = residual(mid)
             if not self._attached():
@@ -1318,52 +1526,27 @@ class ContactSimulator:
             else:
                 hi = mid
                 if r_mid <= 0.0:
-                    return mid, r_mid
-            if hi - lo <= 1e-13 * max(abs(hi), abs(lo), 1e-300):
-                break
-        # Golden-section on the attached interval for the force minimum.
-        a, b = hi, attached
-        golden = 0.5 * (math.sqrt(5.0) - 1.0)
-        c = b - golden * (b - a)
-        d = a + golden * (b - a)
-        rc = residual(c)
-        if rc <= 0.0:
-            return c, rc
-        rd = residual(d)
-        if rd <= 0.0:
-            return d, rd
-        # One new trial per iteration: the interior point that stays is reused.
-        for _ in range(120):
-            if rc < rd:
-                b, d, rd = d, c, rc
-                c = b - golden * (b - a)
-                rc = residual(c)
-                if rc <= 0.0:
-                    return c, rc
-            else:
-                a, c, rc = c, d, rd
-                d = a + golden * (b - a)
-                rd = residual(d)
-                if rd <= 0.0:
-                    return d, rd
-            if abs(b - a) <= 1e-10 * max(abs(a), abs(b), 1e-300):
-                break
-        return None
+                    return self._dip_bracket(trials, target, mid, r_mid), math.nan
+        return None, lo
 
-    def _pulled_off(
-        self, residual, detached: float, attached: float, time: float, start: Snapshot
-    ) -> StepOutput:
+    @staticmethod
+    def _dip_bracket(
+        trials: list[tuple[float, float, float]], target: float, dip: float, r_dip: float
+    ) -> tuple[float, float, float, float]:
+        """The bracket (lo, r_lo, dip, r_dip) of the root between the attached trial `dip`
+        (force at or below the target) and the nearest trial on the held depth's side
+        (larger depth: the search pulls) whose force is above the target (the held depth's
+        trial is one)."""
+        lo, r_lo = min((d, f - target) for d, f, _ in trials if d > dip and f - target > 0.0)
+        return lo, r_lo, dip, r_dip
+
+    def _pulled_off(self, detached: float, time: float, start: Any, last: list[Any]) -> StepOutput:
         """No equilibrium under force control: move to the detached state at the depth where
-        the contact let go, flagged unstable."""
-        lo, hi = detached, attached
-        for _ in range(60):
-            mid = 0.5 * (lo + hi)
-            residual(mid)
-            if self._attached():
-                hi = mid
-            else:
-                lo = mid
-            if hi - lo <= 1e-13 * max(abs(hi), abs(lo), 1e-300):
-                break
-        self.restore(start)
-        return self._move(time, lo, unstable=True)
+        the contact let go (`detached`, m, from `_search_dip`), flagged unstable; `start`:
+        the model's state before the step; `last`: the depth of the last trial and its
+        result (when that trial was at `detached`, the model is in that state already)."""
+        self._force_memo = None
+        if last[0] == detached:
+            return self._publish(time, detached, last[1], unstable=True)
+        self._model.rewind(start)
+        return self._move(time, detached, unstable=True)
