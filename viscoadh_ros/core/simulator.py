@@ -91,13 +91,51 @@ class StepOutput:
 STEP_OUTPUT_FIELDS = tuple(f.name for f in fields(StepOutput))
 
 
-def _new_output(*values: Any) -> StepOutput:
-    """A StepOutput from its field values in order, without the frozen dataclass's
-    ``__init__`` (one ``object.__setattr__`` per field, the larger part of a step's Python
-    cost): the instance is the same (same fields, equality, hash, repr)."""
-    output = object.__new__(StepOutput)
-    output.__dict__.update(zip(STEP_OUTPUT_FIELDS, values, strict=True))
+_object_new = object.__new__
+
+
+def _new_output(
+    time: float,
+    depth: float,
+    force: float,
+    contact_radius: float,
+    phase: Phase,
+    edge_speed: float,
+    effective_work_of_adhesion: float,
+    energy_input: float,
+    energy_dissipated: float,
+    scale_separation_ok: bool,
+    unstable: bool,
+) -> StepOutput:
+    """A StepOutput from its field values, without the frozen dataclass's ``__init__`` (one
+    ``object.__setattr__`` per field, the larger part of a step's Python cost): the instance
+    is the same (same fields, equality, hash, repr). A dict display fills the instance dict
+    (about half the time of zipping the names with the values)."""
+    output = _object_new(StepOutput)
+    output.__dict__.update(
+        {
+            "time": time,
+            "depth": depth,
+            "force": force,
+            "contact_radius": contact_radius,
+            "phase": phase,
+            "edge_speed": edge_speed,
+            "effective_work_of_adhesion": effective_work_of_adhesion,
+            "energy_input": energy_input,
+            "energy_dissipated": energy_dissipated,
+            "scale_separation_ok": scale_separation_ok,
+            "unstable": unstable,
+        }
+    )
     return output
+
+
+# The phases as module constants: an enum member lookup (`Phase.INDENTING`) costs several
+# times a global's.
+_NO_CONTACT = Phase.NO_CONTACT
+_INDENTING = Phase.INDENTING
+_STICKING = Phase.STICKING
+_DETACHING = Phase.DETACHING
 
 
 #: Largest flank slope f'(a) at the contact edge for which the half-space (small-slope) theory
@@ -347,6 +385,9 @@ class _TimeStepped:
     def __init__(self, physics: _Physics, numerics: ResolvedNumerics) -> None:
         self.physics = physics
         self.numerics = numerics
+        # Read every kernel call (the numerics are frozen).
+        self._max_substep = numerics.max_substep
+        self._max_edge_cells = numerics.max_edge_cells
         creep = physics.creep
         e_kelvin = np.array([creep.modulus_star(g) for g in creep.kelvin_shear_moduli], dtype=np.float64)
         # Dampers scale like springs: eta* = 2 eta / (1 - nu).
@@ -465,33 +506,38 @@ class _TimeStepped:
 
     # -- model interface ----------------------------------------------------------------
     def advance(self, d0: float, d1: float, dt: float) -> tuple[float, float, float]:
-        if not self._ensure_row(max(d0, d1)):
-            self.substeps = 0
-            return 0.0, 0.0, 0.0
-        assert self.row is not None
         row = self.row
-        if self._journal is not row:
-            # First kernel call of the transaction on this row: journal its memory (compiled
-            # copy into preallocated buffers) instead of a snapshot of numpy copies.
-            _kernels._copy_state(row.wl, row.wb, row.txn, row.txn_b)
-            self._journal = row
-            start = None
-        else:
-            start = self.get_state()
+        if row is None:
+            if not self._ensure_row(max(d0, d1)):
+                self.substeps = 0
+                return 0.0, 0.0, 0.0
+            row = self.row
+            assert row is not None
+        # The first kernel call of the transaction on this row journals its memory into the
+        # row's `txn` buffers (inside the compiled call, before the kernel writes anything)
+        # instead of a snapshot of numpy copies. `_journal` is set just before that call: no
+        # Python code runs between the two, and once it returned the journal is valid.
+        journal = self._journal is not row
+        start = None if journal else self.get_state()
         radius0, dissipated0 = self.radius, self.dissipated
         while True:
             row = self.row
+            if journal:
+                self._journal = row
             # The kernel itself, not the validating wrapper: the row's arrays are checked
             # when built, the step's scalars by ContactSimulator.step.
-            status = _kernels._advance(
-                *row.kernel_args,
+            status = _kernels._advance_packed(
+                row._state,
+                row._const,
+                journal,
                 self.radius,
                 d0,
                 d1,
                 dt,
-                self.numerics.max_substep,
-                self.numerics.max_edge_cells * row.dx,
+                self._max_substep,
+                self._max_edge_cells * row.dx,
             )
+            journal = False
             if status == _kernels.STATUS_OK:
                 break
             if start is None:
@@ -792,6 +838,8 @@ class ContactSimulator:
             self._model: _ClosedForm | _TimeStepped = _ClosedForm(self.physics)
         else:
             self._model = _TimeStepped(self.physics, self.numerics)
+        # Depth steps may take the lean path in `step` (the time-stepped model only).
+        self._lean = isinstance(self._model, _TimeStepped)
         self.reset(0.0)
 
     # -- public state ---------------------------------------------------------------------
@@ -892,20 +940,128 @@ class ContactSimulator:
         """Advance to `time` (s) under displacement control (`depth`, m) or force control
         (`force`, N); exactly one of them. Returns the new StepOutput. On any error the
         state is left as it was before the call."""
-        saved = (
+        # The lean path, for the common case: a finite float depth at a finite float time not
+        # before the last, on the time-stepped model, not idle above the surface (the general
+        # path drops that memory). It is `_step` / `_move` / `_publish` / `_make_output` in
+        # this one frame, the edge outputs read from the kernel's (`edge_height` and
+        # `edge_gaps` return the same values after an advance): the general path's outputs and
+        # state bit for bit, and its transaction (tests/test_step_lean.py).
+        if force is None and self._lean and isinstance(depth, float) and isinstance(time, float):
+            t = time if type(time) is float else float(time)
+            d = depth if type(depth) is float else float(depth)
+            model = self._model
+            d_prev = self._depth
+            output0 = self._output
+            r0 = output0.contact_radius
+            time0 = self._time
+            if (
+                t - t == 0.0
+                and d - d == 0.0
+                and t >= time0
+                and not (d < 0.0 and d_prev < 0.0 and r0 <= 0.0 and model.is_relaxed())
+            ):
+                energy0 = self._energy_input
+                held0 = self._held_force
+                token = model.begin()
+                try:
+                    dt = t - time0
+                    radius, f, work = model.advance(d_prev, d, dt)
+                    energy = energy0 + work
+                    physics = self.physics
+                    if radius <= 0.0:
+                        phase = _NO_CONTACT
+                        g_edge = 0.0
+                    else:
+                        outside, inside, g_edge = model._edge
+                        if radius > r0:
+                            phase = _INDENTING
+                        elif radius < r0:
+                            phase = _DETACHING
+                        else:
+                            tol = 1e-9 * (abs(d) + physics.c_crit * math.sqrt(radius) + g_edge)
+                            if outside >= -tol:
+                                phase = _INDENTING
+                            elif inside <= tol:
+                                phase = _DETACHING
+                            else:
+                                phase = _STICKING
+                    edge_speed = (radius - r0) / dt if dt > 0.0 else 0.0
+                    u = d - g_edge
+                    if radius > 0.0 and u < 0.0:
+                        effective = physics.e_relaxed * u * u / (2.0 * math.pi * radius)
+                    else:
+                        effective = 0.0
+                    if edge_speed == 0.0:
+                        separated = True
+                    else:
+                        v_c1, v_c2 = physics.critical_speeds
+                        separated = abs(edge_speed) >= (v_c1 if edge_speed > 0.0 else v_c2)
+                    # `_new_output` inline (a call with 11 arguments is ~0.1 us of this path).
+                    output = _object_new(StepOutput)
+                    output.__dict__.update(
+                        {
+                            "time": t,
+                            "depth": d,
+                            "force": f,
+                            "contact_radius": radius,
+                            "phase": phase,
+                            "edge_speed": edge_speed,
+                            "effective_work_of_adhesion": effective,
+                            "energy_input": energy,
+                            "energy_dissipated": model.dissipated,
+                            "scale_separation_ok": separated,
+                            "unstable": False,
+                        }
+                    )
+                    self._energy_input = energy
+                    self._time = t
+                    self._depth = d
+                    self._output = output
+                    self._held_force = None
+                    return output
+                except BaseException:
+                    model.rollback(token)
+                    self._energy_input, self._time, self._depth = energy0, time0, d_prev
+                    self._output, self._held_force = output0, held0
+                    raise
+        return self._step_transaction(time, depth, force)
+
+    def _step_transaction(self, time: float, depth: float | None, force: float | None) -> StepOutput:
+        """`step` on the general path: validation, then `_step` as a transaction."""
+        saved = self._undo_token()
+        try:
+            return self._step(time, depth, force)
+        except BaseException:
+            self._undo(saved)
+            raise
+
+    def _undo_token(self) -> tuple:
+        """Begin a transaction: the token `_undo` takes to bring back the state of now, either
+        from inside the next step (its rollback) or after it succeeded (`core.hand` undoes the
+        contacts of a sample that stepped before a failing one). No copies: the memory comes
+        back from the journal the step's first kernel call writes (`_TimeStepped.begin`). Valid
+        until the simulator's next step or restore."""
+        return (
             self._model.begin(),
             self._time,
             self._depth,
             self._output,
             self._energy_input,
             self._held_force,
+            self._force_memo,
         )
-        try:
-            return self._step(time, depth, force)
-        except BaseException:
-            self._model.rollback(saved[0])
-            self._time, self._depth, self._output, self._energy_input, self._held_force = saved[1:]
-            raise
+
+    def _undo(self, token: tuple) -> None:
+        """Back to the state `_undo_token` saw (see there)."""
+        self._model.rollback(token[0])
+        (
+            self._time,
+            self._depth,
+            self._output,
+            self._energy_input,
+            self._held_force,
+            self._force_memo,
+        ) = token[1:]
 
     def _step(self, time: float, depth: float | None, force: float | None) -> StepOutput:
         t = self._check_time(time)
@@ -1044,22 +1200,22 @@ class ContactSimulator:
         physics = self.physics
         g_edge = self._model.edge_height(radius) if radius > 0.0 else 0.0
         if radius <= 0.0:
-            phase = Phase.NO_CONTACT
+            phase = _NO_CONTACT
         elif radius > r0:
-            phase = Phase.INDENTING
+            phase = _INDENTING
         elif radius < r0:
-            phase = Phase.DETACHING
+            phase = _DETACHING
         else:
             # Pinned edge: say which criterion it rests on, if any (elastic contacts at
-            # rest sit on both; a punch rim blocks attachment).
+            # rest sit on both; a punch rim blocks attachment). `step`'s lean path repeats this.
             tol = 1e-9 * (abs(depth) + physics.c_crit * math.sqrt(radius) + g_edge)
             outside, inside = self._model.edge_gaps(depth)
             if outside >= -tol:
-                phase = Phase.INDENTING
+                phase = _INDENTING
             elif inside <= tol:
-                phase = Phase.DETACHING
+                phase = _DETACHING
             else:
-                phase = Phase.STICKING
+                phase = _STICKING
         edge_speed = (radius - r0) / dt if dt > 0.0 else 0.0
         dissipated = self._model.energy_dissipated(self._energy_input, depth)
         u = depth - g_edge
