@@ -98,7 +98,7 @@ EDGE_TOLERANCE = 1e-12
 TOUCH_BLOCK = 32
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def _phi(x: float) -> tuple:
     """Return ``(exp(-x), (1-exp(-x))/x, (x-1+exp(-x))/x^2)`` for x >= 0, safe at both ends."""
     if x < _SERIES_LIMIT:
@@ -141,7 +141,7 @@ def _psi(x: float) -> tuple:
     return p2, (p1 - p2) / x, (1.0 - 2.0 * p1 + p2) / (x * x)
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def _interior_count(a: float, dx: float, n: int) -> int:
     """Number of elements in contact for radius ``a``: centres below ``a``, >= 1 if a > 0."""
     if a <= 0.0:
@@ -154,7 +154,7 @@ def _interior_count(a: float, dx: float, n: int) -> int:
     return count
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def _g_at(x: float, gf: np.ndarray, df: float) -> float:
     """Profile g at ``x`` by linear interpolation on the fine grid."""
     m = gf.shape[0]
@@ -167,14 +167,14 @@ def _g_at(x: float, gf: np.ndarray, df: float) -> float:
     return gf[j] + t * (gf[j + 1] - gf[j])
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def _minmod(slope: float, before: float) -> float:
     if slope * before <= 0.0:
         return 0.0
     return slope if abs(slope) < abs(before) else before
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def _side_ab(x, values, units, lo, hi, dx, g_c):
     """``(A(x), B(x))`` from the elements lo..hi of one side of the edge.
 
@@ -231,14 +231,14 @@ def _side_ab(x, values, units, lo, hi, dx, g_c):
     return w_x + g_x * b_x, b_x
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def _w_side(x, values, units, lo, hi, dx, g_c, gf, df):
     """Memory ``w(x) = A(x) - g(x) B(x)`` at x from the elements lo..hi of one side, m."""
     a_x, b_x = _side_ab(x, values, units, lo, hi, dx, g_c)
     return a_x - _g_at(x, gf, df) * b_x
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def _h(x, d, wsum, bsum, lo, hi, dx, g_c, gf, df, c_crit):
     """Criterion gap h(x) with the memory of elements lo..hi (one side of the edge)."""
     g = _g_at(x, gf, df)
@@ -554,7 +554,7 @@ def _contact_coefficients(lam, dt, e, phi1, chi, cee, cef, cff):
         cff[m] = p_ff * dt * dt * dt
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def _chain_in_contact(
     wl, wsum, wb, bsum, i, u0, u1, slope, p, p_inv, lam, beta, e, phi1, chi, cee, cef, cff, z, zb
 ):
@@ -598,7 +598,7 @@ def _chain_in_contact(
     return work
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def _chain_free(wl, wsum, wb, bsum, i, decay, e_kelvin):
     """Element i out of contact: each Kelvin element creeps back by its factor `decay`.
     Returns the Kelvin energy per unit width its dampers took, ``sum_k E_k (l^2 - l'^2)``."""
