@@ -617,31 +617,52 @@ def _chain_free(wl, wsum, wb, bsum, i, decay, e_kelvin):
     return lost
 
 
-@numba.njit(cache=True, nogil=True)
-def _kelvin_update(wl, wsum, wb, bsum, diss, n_in, d0, d1, dt, g_c, p, p_inv, lam, beta, rate, e_kelvin, dx):
-    """Exact update of every Kelvin chain over dt for a depth linear from d0 to d1.
+#: Rows of a row's coefficient workspace (`Row.coef`, one column per Kelvin mode): the exact
+#: in-contact update over the current substep length (e, phi1, chi) and its damper work (cee,
+#: cef, cff), the free creep-back decay over it, then the same for `_retime_crossed`'s partial
+#: lengths, then the modal vectors z, zb. ``cache[CACHE_SUBSTEP]`` holds the substep length the
+#: first set belongs to (NaN: none): a row stepped at a fixed dt computes them once.
+_C_E, _C_PHI1, _C_CHI, _C_EE, _C_EF, _C_FF, _C_DECAY = 0, 1, 2, 3, 4, 5, 6
+_C_RETIME = 7
+_C_Z, _C_ZB = 14, 15
+COEF_ROWS = 16
+CACHE_SUBSTEP = 0
+CACHE_SIZE = 1
 
-    Interior elements (i < n_in): modal form of ``dl/dt = A l + b u(t)``, ``u = d - g``.
-    Exterior elements: free creep-back ``dl_k/dt = -rate_k l_k``. ``diss[i]`` gets the
-    energy element i dissipated, J (both half-rows: 2 dx times the damper work per width
-    for the glass-spring-driven chain, dx times the Kelvin energy lost creeping back).
-    """
-    n, k_count = wl.shape
-    if k_count == 0 or dt <= 0.0:
-        for i in range(n):
-            diss[i] = 0.0
+
+@numba.njit(cache=True, nogil=True)
+def _substep_coefficients(lam, rate, h, coef, cache):
+    """The in-contact coefficients and free decays over a substep of length h into ``coef``
+    (`_contact_coefficients`, ``exp(-rate h)``), unless they already hold those of h."""
+    if cache[CACHE_SUBSTEP] == h:
         return
-    e = np.empty(k_count)
-    phi1 = np.empty(k_count)
-    chi = np.empty(k_count)
-    cee = np.empty(k_count)
-    cef = np.empty(k_count)
-    cff = np.empty(k_count)
-    z = np.empty(k_count)
-    zb = np.empty(k_count)
-    _contact_coefficients(lam, dt, e, phi1, chi, cee, cef, cff)
-    slope = (d1 - d0) / dt
-    for i in range(n_in):
+    _contact_coefficients(
+        lam, h, coef[_C_E], coef[_C_PHI1], coef[_C_CHI], coef[_C_EE], coef[_C_EF], coef[_C_FF]
+    )
+    decay = coef[_C_DECAY]
+    for k in range(rate.shape[0]):
+        decay[k] = math.exp(-rate[k] * h)
+    cache[CACHE_SUBSTEP] = h
+
+
+@numba.njit(cache=True, nogil=True)
+def _update_range(
+    wl, wsum, wb, bsum, diss, lo, hi, n_in, d0, d1, slope, g_c, p, p_inv, lam, beta, coef, e_kelvin, dx, total
+):
+    """`_kelvin_update` of elements lo..hi-1 with the coefficients in ``coef`` (one substep,
+    `_substep_coefficients`); returns ``total`` plus the energy they dissipated, J, added
+    element by element in index order (so a sum over ranges taken in order is the sum over
+    the row)."""
+    e = coef[_C_E]
+    phi1 = coef[_C_PHI1]
+    chi = coef[_C_CHI]
+    cee = coef[_C_EE]
+    cef = coef[_C_EF]
+    cff = coef[_C_FF]
+    decay = coef[_C_DECAY]
+    z = coef[_C_Z]
+    zb = coef[_C_ZB]
+    for i in range(lo, min(hi, n_in)):
         work = _chain_in_contact(
             wl,
             wsum,
@@ -665,10 +686,53 @@ def _kelvin_update(wl, wsum, wb, bsum, diss, n_in, d0, d1, dt, g_c, p, p_inv, la
             zb,
         )
         diss[i] = 2.0 * dx * work
-    for k in range(k_count):
-        e[k] = math.exp(-rate[k] * dt)
-    for i in range(n_in, n):
-        diss[i] = dx * _chain_free(wl, wsum, wb, bsum, i, e, e_kelvin)
+        total += diss[i]
+    for i in range(max(lo, n_in), hi):
+        diss[i] = dx * _chain_free(wl, wsum, wb, bsum, i, decay, e_kelvin)
+        total += diss[i]
+    return total
+
+
+@numba.njit(cache=True, nogil=True)
+def _kelvin_update(wl, wsum, wb, bsum, diss, n_in, d0, d1, dt, g_c, p, p_inv, lam, beta, rate, e_kelvin, dx):
+    """Exact update of every Kelvin chain over dt for a depth linear from d0 to d1.
+
+    Interior elements (i < n_in): modal form of ``dl/dt = A l + b u(t)``, ``u = d - g``.
+    Exterior elements: free creep-back ``dl_k/dt = -rate_k l_k``. ``diss[i]`` gets the
+    energy element i dissipated, J (both half-rows: 2 dx times the damper work per width
+    for the glass-spring-driven chain, dx times the Kelvin energy lost creeping back).
+    `_advance` runs the same update range by range (`_update_range`).
+    """
+    n, k_count = wl.shape
+    if k_count == 0 or dt <= 0.0:
+        for i in range(n):
+            diss[i] = 0.0
+        return
+    coef = np.empty((COEF_ROWS, k_count))
+    cache = np.full(CACHE_SIZE, np.nan)
+    _substep_coefficients(lam, rate, dt, coef, cache)
+    _update_range(
+        wl,
+        wsum,
+        wb,
+        bsum,
+        diss,
+        0,
+        n,
+        n_in,
+        d0,
+        d1,
+        (d1 - d0) / dt,
+        g_c,
+        p,
+        p_inv,
+        lam,
+        beta,
+        coef,
+        e_kelvin,
+        dx,
+        0.0,
+    )
 
 
 @numba.njit(cache=True, nogil=True)
@@ -680,6 +744,7 @@ def _retime_crossed(
     scratch,
     scratch_b,
     diss,
+    coef,
     a0,
     a1,
     da,
@@ -709,21 +774,24 @@ def _retime_crossed(
     fold) is taken at the substep's end. At the switch the element's glass spring takes
     (attach) or gives up (let go) ``E0* dx l0^2`` while its annulus gives up or regains
     the surface energy ``E0* c^2 x dx``: the difference is lost.
+
+    Reads the crossed elements' state from before the substep in ``scratch``/``scratch_b``
+    and works in the retime rows of the workspace ``coef`` (`COEF_ROWS`); allocates nothing.
     """
     n, k_count = wl.shape
     n0 = _interior_count(a0, dx, n)
     n1 = _interior_count(a1, dx, n)
     if n0 == n1:
         return 0.0
-    e = np.empty(k_count)
-    phi1 = np.empty(k_count)
-    chi = np.empty(k_count)
-    cee = np.empty(k_count)
-    cef = np.empty(k_count)
-    cff = np.empty(k_count)
-    z = np.empty(k_count)
-    zb = np.empty(k_count)
-    decay = np.empty(k_count)
+    e = coef[_C_RETIME + _C_E]
+    phi1 = coef[_C_RETIME + _C_PHI1]
+    chi = coef[_C_RETIME + _C_CHI]
+    cee = coef[_C_RETIME + _C_EE]
+    cef = coef[_C_RETIME + _C_EF]
+    cff = coef[_C_RETIME + _C_FF]
+    decay = coef[_C_RETIME + _C_DECAY]
+    z = coef[_C_Z]
+    zb = coef[_C_ZB]
     slope = (db - da) / dt if dt > 0.0 else 0.0
     hysteresis = 0.0
     lo, hi = (n0, n1) if n1 > n0 else (n1, n0)
@@ -829,8 +897,18 @@ def _copy_state(src, src_b, dst, dst_b):
 
 
 @numba.njit(cache=True, nogil=True)
-def _restore_state(wl, wsum, wb, bsum, src, src_b):
-    for i in range(wl.shape[0]):
+def _copy_range(src, src_b, dst, dst_b, lo, hi):
+    """`_copy_state` of elements lo..hi-1."""
+    for i in range(lo, hi):
+        for k in range(src.shape[1]):
+            dst[i, k] = src[i, k]
+            dst_b[i, k] = src_b[i, k]
+
+
+@numba.njit(cache=True, nogil=True)
+def _restore_range(wl, wsum, wb, bsum, src, src_b, lo, hi):
+    """`_restore_state` of elements lo..hi-1."""
+    for i in range(lo, hi):
         total = 0.0
         total_b = 0.0
         for k in range(wl.shape[1]):
@@ -840,6 +918,11 @@ def _restore_state(wl, wsum, wb, bsum, src, src_b):
             total_b += wb[i, k]
         wsum[i] = total
         bsum[i] = total_b
+
+
+@numba.njit(cache=True, nogil=True)
+def _restore_state(wl, wsum, wb, bsum, src, src_b):
+    _restore_range(wl, wsum, wb, bsum, src, src_b, 0, wl.shape[0])
 
 
 @numba.njit(cache=True, nogil=True)
@@ -858,6 +941,32 @@ def _edge_outputs(a, d, wsum, bsum, dx, g_c, gf, df, c_crit, out):
 
 
 @numba.njit(cache=True, nogil=True)
+def _trial_window(a, n_in, n, dx, df, max_move):
+    """Elements ``lo..hi-1`` that a substep trial must update before `_locate_edge` with the
+    motion limit ``max_move`` (m) from the radius ``a > 0``: every element that search reads.
+
+    The limited search only looks near the edge: inward (detachment) it stops once it is
+    more than max_move inside a, outward (attachment, `_scan_out`) once beyond a + max_move;
+    each scan may overshoot that by one block of `TOUCH_BLOCK` fine points (`_h_bounds`) plus
+    one fine point, and `_side_ab`/`_h_bounds` read up to two elements beyond a point (the
+    interior's extrapolation three back from its last element, the exterior's two ahead of
+    its first). The window covers that reach doubled, plus three elements each side.
+    """
+    span = max_move + 2.0 * (TOUCH_BLOCK + 2) * df
+    x_lo = a - span
+    x_hi = a + span
+    lo = 0
+    if x_lo > 0.0:
+        lo = max(int(x_lo / dx - 0.5) - 3, 0)
+    hi = n
+    if x_hi < n * dx:
+        hi = min(int(x_hi / dx - 0.5) + 4, n)
+    lo = min(lo, max(n_in - 4, 0))
+    hi = max(hi, min(n_in + 3, n))
+    return lo, hi
+
+
+@numba.njit(cache=True, nogil=True)
 def _advance(
     wl,
     wsum,
@@ -866,6 +975,8 @@ def _advance(
     scratch,
     scratch_b,
     diss,
+    coef,
+    cache,
     dx,
     g_c,
     gf,
@@ -904,11 +1015,97 @@ def _advance(
     STATUS_GROW (state partly advanced: the caller restores) when the contact needs a larger
     domain.
     """
-    n = wl.shape[0]
+    force_prev = _force(a, d0, wsum, bsum, dx, g_c, gf, gint, df, e0, kap)
+    return _advance_from(
+        wl,
+        wsum,
+        wb,
+        bsum,
+        scratch,
+        scratch_b,
+        diss,
+        coef,
+        cache,
+        dx,
+        g_c,
+        gf,
+        gint,
+        gmin,
+        gmax,
+        df,
+        e0,
+        c_crit,
+        reach,
+        p,
+        p_inv,
+        lam,
+        beta,
+        rate,
+        kap,
+        e_kelvin,
+        out,
+        a,
+        d0,
+        d1,
+        dt,
+        max_substep,
+        max_edge_move,
+        force_prev,
+    )
+
+
+@numba.njit(cache=True, nogil=True)
+def _advance_from(
+    wl,
+    wsum,
+    wb,
+    bsum,
+    scratch,
+    scratch_b,
+    diss,
+    coef,
+    cache,
+    dx,
+    g_c,
+    gf,
+    gint,
+    gmin,
+    gmax,
+    df,
+    e0,
+    c_crit,
+    reach,
+    p,
+    p_inv,
+    lam,
+    beta,
+    rate,
+    kap,
+    e_kelvin,
+    out,
+    a,
+    d0,
+    d1,
+    dt,
+    max_substep,
+    max_edge_move,
+    force_prev,
+):
+    """`_advance` given the force at the step's start, ``force_prev`` (N: `_force` at (a, d0)
+    on the current memory; `_advance_rows` has it from the row before).
+
+    A substep trial with the motion limit (in contact) journals and updates only the window
+    of elements the limited edge search reads (`_trial_window`): a rejected trial restores
+    that window and costs O(window), not O(N). An accepted one updates the other elements
+    with the same coefficients (element by element the same arithmetic as one pass over the
+    row) and sums their losses and the memory peak on the way, in index order. Without the
+    limit (no contact: the first-touch search reads the whole row; or the shortest substep)
+    the trial updates every element.
+    """
+    n, k_count = wl.shape
     h_min = dt * JUMP_RESOLUTION
     step = dt if max_substep <= 0.0 or max_substep > dt else max_substep
     tau = 0.0
-    force_prev = _force(a, d0, wsum, bsum, dx, g_c, gf, gint, df, e0, kap)
     work = 0.0
     lost = 0.0
     motion = MOTION_NONE
@@ -921,8 +1118,11 @@ def _advance(
         )
         if grow:
             return STATUS_GROW
-        # The elements that switch at a jump in depth switch at the new depth.
-        _copy_state(wl, wb, scratch, scratch_b)
+        # The elements that switch at a jump in depth switch at the new depth (from the state
+        # journalled here: only the crossed elements are read back).
+        n0 = _interior_count(a, dx, n)
+        n1 = _interior_count(new_a, dx, n)
+        _copy_range(wl, wb, scratch, scratch_b, min(n0, n1), max(n0, n1))
         hysteresis = _retime_crossed(
             wl,
             wsum,
@@ -931,6 +1131,7 @@ def _advance(
             scratch,
             scratch_b,
             diss,
+            coef,
             a,
             new_a,
             d1,
@@ -964,12 +1165,37 @@ def _advance(
             h = dt - tau
         da = d0 + (d1 - d0) * (tau / dt)
         db = d1 if last else d0 + (d1 - d0) * ((tau + h) / dt)
-        _copy_state(wl, wb, scratch, scratch_b)
         n_in = _interior_count(a, dx, n)
-        _kelvin_update(
-            wl, wsum, wb, bsum, diss, n_in, da, db, h, g_c, p, p_inv, lam, beta, rate, e_kelvin, dx
-        )
         limited = h > h_min and attempts + 1 < _MAX_ATTEMPTS
+        lo, hi = 0, n
+        slope = (db - da) / h
+        if k_count:
+            if limited and a > 0.0:
+                lo, hi = _trial_window(a, n_in, n, dx, df, max_edge_move)
+            _substep_coefficients(lam, rate, h, coef, cache)
+            _copy_range(wl, wb, scratch, scratch_b, lo, hi)
+            _update_range(
+                wl,
+                wsum,
+                wb,
+                bsum,
+                diss,
+                lo,
+                hi,
+                n_in,
+                da,
+                db,
+                slope,
+                g_c,
+                p,
+                p_inv,
+                lam,
+                beta,
+                coef,
+                e_kelvin,
+                dx,
+                0.0,
+            )
         new_a, sub_motion, grow = _locate_edge(
             a,
             db,
@@ -989,9 +1215,35 @@ def _advance(
             return STATUS_GROW
         attempts += 1
         if abs(new_a - a) > max_edge_move and limited:
-            _restore_state(wl, wsum, wb, bsum, scratch, scratch_b)
+            if k_count:
+                _restore_range(wl, wsum, wb, bsum, scratch, scratch_b, lo, hi)
             step = 0.5 * h
             continue
+        # Accepted: the elements before the window (in index order: their losses first) ...
+        viscous = 0.0
+        if k_count:
+            viscous = _update_range(
+                wl,
+                wsum,
+                wb,
+                bsum,
+                diss,
+                0,
+                lo,
+                n_in,
+                da,
+                db,
+                slope,
+                g_c,
+                p,
+                p_inv,
+                lam,
+                beta,
+                coef,
+                e_kelvin,
+                dx,
+                0.0,
+            )
         hysteresis = _retime_crossed(
             wl,
             wsum,
@@ -1000,6 +1252,7 @@ def _advance(
             scratch,
             scratch_b,
             diss,
+            coef,
             a,
             new_a,
             da,
@@ -1016,10 +1269,32 @@ def _advance(
             e0,
             c_crit,
         )
-        viscous = 0.0
-        if wl.shape[1]:
-            for i in range(n):
+        if k_count:
+            # ... the window (retimed where the edge crossed), then the elements after it.
+            for i in range(lo, hi):
                 viscous += diss[i]
+            viscous = _update_range(
+                wl,
+                wsum,
+                wb,
+                bsum,
+                diss,
+                hi,
+                n,
+                n_in,
+                da,
+                db,
+                slope,
+                g_c,
+                p,
+                p_inv,
+                lam,
+                beta,
+                coef,
+                e_kelvin,
+                dx,
+                viscous,
+            )
         lost += viscous + max(hysteresis, 0.0)
         force_new = _force(new_a, db, wsum, bsum, dx, g_c, gf, gint, df, e0, kap)
         work += 0.5 * (force_prev + force_new) * (db - da)
@@ -1060,6 +1335,8 @@ def _advance_rows(
     scratch,
     scratch_b,
     diss,
+    coef,
+    cache,
     dx,
     g_c,
     gf,
@@ -1105,13 +1382,17 @@ def _advance_rows(
     with STATUS_IDLE (idle above the surface: the caller drops the memory, as
     ContactSimulator does) or STATUS_GROW (memory restored: the caller grows the domain and
     calls again from row i).
+
+    A row starts from the force the row before ended with (the same memory, radius and
+    depth: `_force` would return the same number).
     """
+    force_prev = _force(a, d_prev, wsum, bsum, dx, g_c, gf, gint, df, e0, kap)
     for i in range(first, times.shape[0]):
         d1 = depths[i]
         if a <= 0.0 and peak <= idle_limit and d1 < 0.0 and d_prev < 0.0:
             return i, STATUS_IDLE
         _copy_state(wl, wb, backup, backup_b)
-        status = _advance(
+        status = _advance_from(
             wl,
             wsum,
             wb,
@@ -1119,6 +1400,8 @@ def _advance_rows(
             scratch,
             scratch_b,
             diss,
+            coef,
+            cache,
             dx,
             g_c,
             gf,
@@ -1143,12 +1426,14 @@ def _advance_rows(
             times[i] - t_prev,
             max_substep,
             max_edge_move,
+            force_prev,
         )
         if status != STATUS_OK:
             _restore_state(wl, wsum, wb, bsum, backup, backup_b)
             return i, status
         a = out[OUT_RADIUS]
         peak = out[OUT_MEMORY]
+        force_prev = out[OUT_FORCE]
         for k in range(OUT_SIZE):
             rows[i, k] = out[k]
         t_prev = times[i]
@@ -1350,6 +1635,9 @@ class Row:
         self.txn = np.empty_like(self.wl)
         self.txn_b = np.empty_like(self.wl)
         self.diss = np.zeros(n)
+        # The kernel's coefficient workspace (`COEF_ROWS`, K) and the substep length it holds.
+        self.coef = np.zeros((COEF_ROWS, k))
+        self.cache = np.full(CACHE_SIZE, np.nan)
         self.p, self.p_inv, self.lam, self.beta, self.rate = p, p_inv, lam, beta, rate
         self.e_kelvin, self.steady = e_kelvin, steady
         self.kap = float(steady.sum())
@@ -1378,6 +1666,8 @@ class Row:
             self.scratch,
             self.scratch_b,
             self.diss,
+            self.coef,
+            self.cache,
             self.dx,
             self.g_c,
             self.gf,
@@ -1425,6 +1715,8 @@ class Row:
         clone.txn = np.empty_like(self.txn)
         clone.txn_b = np.empty_like(self.txn_b)
         clone.diss = np.zeros_like(self.diss)
+        clone.coef = np.zeros_like(self.coef)
+        clone.cache = np.full(CACHE_SIZE, np.nan)
         clone.out = np.zeros(OUT_SIZE)
         clone._kernel_args = None
         clone.set_memory(wl, wb)
