@@ -681,24 +681,31 @@ def _chain_free(wl, wsum, wb, bsum, i, decay, e_kelvin):
     return lost
 
 
-#: Rows of a row's coefficient workspace (`Row.coef`, one column per Kelvin mode): the exact
-#: in-contact update over the current substep length (e, phi1, chi) and its damper work (cee,
-#: cef, cff), the free creep-back decay over it, then the same for `_retime_crossed`'s partial
-#: lengths, then the modal vectors z, zb. ``cache[CACHE_SUBSTEP]`` holds the substep length the
-#: first set belongs to (NaN: none): a row stepped at a fixed dt computes them once.
+#: Rows of a row's coefficient workspace (`Row.coef`, shape (COEF_ROWS, max(K, 1)), one column
+#: per Kelvin mode): the exact in-contact update over the current substep length (e, phi1, chi)
+#: and its damper work (cee, cef, cff), the free creep-back decay over it, then the same for
+#: `_retime_crossed`'s partial lengths, then the modal vectors z, zb; ``coef[_C_SUBSTEP, 0]``
+#: holds the substep length the first set belongs to (NaN: none): a row stepped at a fixed dt
+#: computes them once. (One array, not two: each array argument costs the call from Python.)
 _C_E, _C_PHI1, _C_CHI, _C_EE, _C_EF, _C_FF, _C_DECAY = 0, 1, 2, 3, 4, 5, 6
 _C_RETIME = 7
 _C_Z, _C_ZB = 14, 15
-COEF_ROWS = 16
-CACHE_SUBSTEP = 0
-CACHE_SIZE = 1
+_C_SUBSTEP = 16
+COEF_ROWS = 17
+
+
+def coefficient_workspace(kelvin: int) -> np.ndarray:
+    """A fresh `Row.coef` for a chain of `kelvin` Kelvin elements (holding no substep yet)."""
+    coef = np.zeros((COEF_ROWS, max(kelvin, 1)))
+    coef[_C_SUBSTEP, 0] = np.nan
+    return coef
 
 
 @numba.njit(cache=True, nogil=True)
-def _substep_coefficients(lam, rate, h, coef, cache):
+def _substep_coefficients(lam, rate, h, coef):
     """The in-contact coefficients and free decays over a substep of length h into ``coef``
     (`_contact_coefficients`, ``exp(-rate h)``), unless they already hold those of h."""
-    if cache[CACHE_SUBSTEP] == h:
+    if coef[_C_SUBSTEP, 0] == h:
         return
     _contact_coefficients(
         lam, h, coef[_C_E], coef[_C_PHI1], coef[_C_CHI], coef[_C_EE], coef[_C_EF], coef[_C_FF]
@@ -706,7 +713,7 @@ def _substep_coefficients(lam, rate, h, coef, cache):
     decay = coef[_C_DECAY]
     for k in range(rate.shape[0]):
         decay[k] = math.exp(-rate[k] * h)
-    cache[CACHE_SUBSTEP] = h
+    coef[_C_SUBSTEP, 0] = h
 
 
 @numba.njit(cache=True, nogil=True)
@@ -896,8 +903,8 @@ def _kelvin_update(wl, wsum, wb, bsum, diss, n_in, d0, d1, dt, g_c, p, p_inv, la
             diss[i] = 0.0
         return
     coef = np.empty((COEF_ROWS, k_count))
-    cache = np.full(CACHE_SIZE, np.nan)
-    _substep_coefficients(lam, rate, dt, coef, cache)
+    coef[_C_SUBSTEP, 0] = np.nan
+    _substep_coefficients(lam, rate, dt, coef)
     _update_range(
         wl,
         wsum,
@@ -1168,7 +1175,6 @@ def _advance(
     scratch_b,
     diss,
     coef,
-    cache,
     dx,
     g_c,
     gf,
@@ -1217,7 +1223,6 @@ def _advance(
         scratch_b,
         diss,
         coef,
-        cache,
         dx,
         g_c,
         gf,
@@ -1256,7 +1261,6 @@ def _advance_from(
     scratch_b,
     diss,
     coef,
-    cache,
     dx,
     g_c,
     gf,
@@ -1366,7 +1370,7 @@ def _advance_from(
         if k_count:
             if limited and a > 0.0:
                 lo, hi = _trial_window(a, n_in, n, dx, df, max_edge_move)
-            _substep_coefficients(lam, rate, h, coef, cache)
+            _substep_coefficients(lam, rate, h, coef)
             _copy_range(wl, wb, scratch, scratch_b, lo, hi)
             _update_range(
                 wl,
@@ -1534,7 +1538,6 @@ def _advance_rows(
     scratch_b,
     diss,
     coef,
-    cache,
     dx,
     g_c,
     gf,
@@ -1599,7 +1602,6 @@ def _advance_rows(
             scratch_b,
             diss,
             coef,
-            cache,
             dx,
             g_c,
             gf,
@@ -1833,9 +1835,8 @@ class Row:
         self.txn = np.empty_like(self.wl)
         self.txn_b = np.empty_like(self.wl)
         self.diss = np.zeros(n)
-        # The kernel's coefficient workspace (`COEF_ROWS`, K) and the substep length it holds.
-        self.coef = np.zeros((COEF_ROWS, k))
-        self.cache = np.full(CACHE_SIZE, np.nan)
+        # The kernel's coefficient workspace and the substep length it holds (`COEF_ROWS`).
+        self.coef = coefficient_workspace(k)
         self.p, self.p_inv, self.lam, self.beta, self.rate = p, p_inv, lam, beta, rate
         self.e_kelvin, self.steady = e_kelvin, steady
         self.kap = float(steady.sum())
@@ -1865,7 +1866,6 @@ class Row:
             self.scratch_b,
             self.diss,
             self.coef,
-            self.cache,
             self.dx,
             self.g_c,
             self.gf,
@@ -1913,8 +1913,7 @@ class Row:
         clone.txn = np.empty_like(self.txn)
         clone.txn_b = np.empty_like(self.txn_b)
         clone.diss = np.zeros_like(self.diss)
-        clone.coef = np.zeros_like(self.coef)
-        clone.cache = np.full(CACHE_SIZE, np.nan)
+        clone.coef = coefficient_workspace(self.wl.shape[1])
         clone.out = np.zeros(OUT_SIZE)
         clone._kernel_args = None
         clone.set_memory(wl, wb)
