@@ -5,10 +5,10 @@
 Loads ``viscoadh_ros/core/_kernels.py`` of the old checkout as a separate module beside this
 checkout's, builds the `viscoadh bench --sections kernel` state for each (N, K) (standard
 solid pressed to the cycle's deepest point and back, then 400 rows of the 1 kHz cycle), and
-times, interleaved and median of 7, per row: `_advance` row by row in a compiled loop (old,
-new), `_advance_rows` (old, new) and `MinimalStepper.run`. The rows of both `_advance_rows`
-must be equal bit for bit (asserted), so the script also proves the new kernel's outputs on
-these scenes. Only ratios from one sitting count (shared machine).
+times, interleaved and median of 7 (31 at N <= 256), per row: `_advance` row by row in a
+compiled loop (old, new), `_advance_rows` (old, new) and `MinimalStepper.run`. The rows of
+both `_advance_rows` must be equal bit for bit (asserted), so the script also proves the new
+kernel's outputs on these scenes. Only ratios from one sitting count (shared machine).
 """
 
 from __future__ import annotations
@@ -156,7 +156,8 @@ def measure(old, elements: int, kelvin: int) -> dict[str, float]:
         run()
     assert np.array_equal(out["old"], out["new"]), "the kernels' rows differ"
     samples: dict[str, list[float]] = {key: [] for key in runs}
-    for _ in range(7):
+    # Short runs (small N) are the most exposed to a shared machine's preemptions: more repeats.
+    for _ in range(7 if elements > 256 else 31):
         for key, run in runs.items():
             start = time.perf_counter()
             run()
