@@ -1745,12 +1745,24 @@ def _stored_energy(a, d, wl, wb, dx, g_c, gf, df, e0, e_kelvin):
 # Public wrappers: validate, then call the compiled kernel.
 
 
+@numba.njit(cache=True, nogil=True)
+def _all_finite(values):
+    """True if every entry of the 1-D array is finite (stops at the first that is not)."""
+    for i in range(values.shape[0]):
+        if not math.isfinite(values[i]):
+            return False
+    return True
+
+
 def _check(name: str, array: np.ndarray, shape: tuple[int, ...]) -> None:
     if not isinstance(array, np.ndarray) or array.dtype != np.float64:
         raise TypeError(f"{name} must be a float64 numpy array")
     if array.shape != shape:
         raise ValueError(f"{name} must have shape {shape} (got {array.shape})")
-    if not np.all(np.isfinite(array)):
+    # Compiled on the flat view of a C-contiguous array (one signature, warmed up): ~0.3 us
+    # against numpy's ~3 us per array, a dozen arrays per row a domain growth builds.
+    finite = _all_finite(array.reshape(-1)) if array.flags.c_contiguous else np.all(np.isfinite(array))
+    if not finite:
         raise ValueError(f"{name} must be finite")
 
 
