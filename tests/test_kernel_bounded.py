@@ -150,3 +150,65 @@ def test_step_rollback_after_the_kernel_ran_restores_every_output() -> None:
     for sim in (live, twin):
         sim.step(sim.time + 1e-3, depth=3e-6)
     assert live.output == twin.output
+
+
+def _wide_row(kelvin: tuple, viscosities: tuple, seed: int, *, smooth: bool, preset: str) -> _kernels.Row:
+    """A 160-element row (`preset`'s fine grid) with random memory, like `_row`."""
+    contact = one_contact(
+        {"shape": "sphere", "radius": 1e-3},
+        kelvin=kelvin,
+        viscosities=viscosities,
+        work=0.05,
+        numerics={"model": "time_stepped", "elements": 160, "preset": preset},
+    )
+    model = ContactSimulator(contact)._model
+    rng = np.random.default_rng(seed)
+    n, k = 160, len(kelvin)
+    if smooth:
+        x = np.linspace(0.0, 1.0, n)[:, None]
+        memory = 2e-6 * (
+            rng.normal(size=(1, k)) + rng.normal(size=(1, k)) * x + rng.normal(size=(1, k)) * x**2
+        )
+    else:
+        memory = rng.normal(scale=2e-6, size=(n, k))
+    unit = rng.uniform(size=(n, k)) * model.steady
+    return model._build_row(2e-4, memory, unit)
+
+
+@pytest.mark.parametrize("preset", ["fast", "balanced"])
+@pytest.mark.parametrize("smooth", [False, True])
+@pytest.mark.parametrize(("kelvin", "viscosities"), [((1e5,), (1e3,)), ((2e5, 5e4, 1e6), (1e2, 1e4, 1e-1))])
+def test_the_motion_limited_edge_search_reads_only_the_trial_window(
+    kelvin, viscosities, smooth, preset
+) -> None:
+    """A substep trial in contact updates only `_trial_window`'s elements before the
+    motion-limited edge search (issue 13): whatever the memory outside the window holds
+    (NaN, far above or below, noise), the search returns exactly the same radius, motion and
+    grow flag, accepted or rejected, at every motion limit the presets use and beyond."""
+    searched = rejected = 0
+    for seed in range(4):
+        row = _wide_row(kelvin, viscosities, seed, smooth=smooth, preset=preset)
+        n = row.elements
+        rng = np.random.default_rng(200 + seed)
+        for _ in range(25):
+            a = float(rng.uniform(0.01, 0.99) * row.length)
+            d = float(rng.uniform(-3e-6, 1.5e-5))
+            max_move = float(rng.choice([0.5, 1.0, 2.0, 5.0])) * row.dx
+            tail = (row.dx, row.g_c, row.gf, row.gmin, row.gmax, row.df, row.c_crit, row.reach, max_move)
+            want = _kernels._locate_edge(a, d, row.wsum, row.bsum, *tail)
+            n_in = _kernels._interior_count(a, row.dx, n)
+            lo, hi = _kernels._trial_window(a, n_in, n, row.dx, row.df, max_move)
+            assert 0 <= lo < hi <= n and lo <= max(n_in - 4, 0) and hi >= min(n_in + 3, n)
+            if lo == 0 and hi == n:
+                continue
+            searched += 1
+            rejected += abs(want[0] - a) > max_move
+            for poison in (math.nan, 1e-3, -1e-3, None):
+                wsum, bsum = row.wsum.copy(), row.bsum.copy()
+                for values in (wsum, bsum):
+                    fill = rng.normal(scale=1e-4, size=n) if poison is None else np.full(n, poison)
+                    values[:lo] = fill[:lo]
+                    values[hi:] = fill[hi:]
+                got = _kernels._locate_edge(a, d, wsum, bsum, *tail)
+                assert got == want, (seed, a, d, max_move, lo, hi, poison)
+    assert searched >= 60 and rejected >= 5, (searched, rejected)

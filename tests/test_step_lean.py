@@ -154,7 +154,7 @@ def test_the_packed_views_are_the_rows_kernel_arguments(kelvin: int) -> None:
             if isinstance(want, np.ndarray):
                 assert got.shape == want.shape
                 assert want.size == 0 or got.ctypes.data == want.ctypes.data  # (no data: any address)
-                assert np.array_equal(got, want)
+                assert np.array_equal(got, want, equal_nan=True)  # coef holds NaN: no substep yet
             else:
                 assert got == want
         if txn.size:

@@ -61,7 +61,9 @@ def _bare_steps(wl, wsum, g_c, depth):  # pragma: no cover - compiled
             wsum[i] = total + 1e-3 * u
 
 
-@numba.njit(cache=True)
+# Not cached: numba's on-disk cache of a function does not notice a change to the functions it
+# calls in another module, so a cached loop would go on timing the kernel it was first built with.
+@numba.njit
 def _kernel_steps(row_args, radius, depth, dt, max_substep, max_edge_move):  # pragma: no cover - compiled
     """The simulator's kernel over a depth history; returns the total number of substeps.
 
