@@ -3,11 +3,14 @@
 Messages are deserialised with :func:`rclpy.serialization.deserialize_message` into the
 installed message classes, or read in bulk as raw CDR (:meth:`Bag.raw`, :meth:`Bag.rows`) for
 the fixed-layout decoders of :mod:`viscoadh_ros.io.cdr`. The file is walked here, record by
-record with one ``struct`` call each (message indexes and the summary are skipped: the
-``mcap`` package's reader parses every index entry as an object, which cost more than the
-messages); a chunk's message records are located the same way and then read as columns
-(channel, log time, payload offset and size as numpy arrays; payloads of one length as one
-(n, L) array). A file that was not finished (a recorder killed mid-run) has no footer: it is
+record with one ``struct`` call each (the summary is skipped: the ``mcap`` package's reader
+parses every index entry as an object, which cost more than the messages). A chunk's message
+records are located from the message index records that follow it, read as numpy arrays and
+accepted only when they tile the chunk exactly (every record a message, each starting where
+the one before ends); otherwise (no or partial indexes, a channel or schema record inside the
+chunk, a damaged index) the chunk is walked record by record. The messages are then read as
+columns (channel, log time, payload offset and size as numpy arrays; payloads of one length
+as one (n, L) array). A file that was not finished (a recorder killed mid-run) has no footer: it is
 read up to the last complete chunk; :class:`Bag` refuses it with a clear :class:`InputError`
 unless ``recover=True``.
 """
@@ -123,6 +126,59 @@ def _bag_files(path: Path) -> list[Path]:
     return files
 
 
+def _unaligned(buffer: NDArray[np.uint8], dtype: str) -> NDArray:
+    """``buffer`` read as ``dtype`` numbers starting at every byte (a view, no copy): element k
+    is the number whose first byte is ``buffer[k]``."""
+    itemsize = np.dtype(dtype).itemsize
+    return np.ndarray((max(buffer.size - itemsize + 1, 0),), dtype, buffer, 0, (1,))
+
+
+def _message_indexes(data: bytes, position: int) -> list[tuple[int, int]]:
+    """The (start, end) of the bodies of the complete message index records from
+    ``position`` on (those that follow a chunk)."""
+    found = []
+    length = len(data)
+    while position + _RECORD_HEADER.size <= length:
+        opcode, size = _RECORD_HEADER.unpack_from(data, position)
+        start = position + _RECORD_HEADER.size
+        if opcode != Opcode.MESSAGE_INDEX or start + size > length:
+            break
+        found.append((start, start + size))
+        position = start + size
+    return found
+
+
+def _indexed_starts(
+    data: bytes, buffer: NDArray[np.uint8], indexes: list[tuple[int, int]]
+) -> NDArray[np.int64] | None:
+    """The offsets of a chunk's message records (``buffer``: its records) from its message
+    indexes (bodies at ``indexes`` in ``data``), in record order; None unless those records
+    tile the chunk exactly: the first at 0, each next one where the one before ends, the last
+    ending at the chunk's end, every one a message record (then the walk finds the same)."""
+    offsets = []
+    for start, end in indexes:
+        if end - start < 6:
+            return None
+        (entries,) = struct.unpack_from("<I", data, start + 2)
+        if entries % 16 or 6 + entries != end - start:
+            return None
+        offsets.append(np.frombuffer(data, "<u8", entries // 8, start + 6)[1::2])
+    if not offsets:
+        return None
+    found = np.concatenate(offsets)
+    if found.size == 0 or np.any(found > buffer.size):
+        return None
+    starts = np.sort(found.astype(np.int64), kind="stable")  # runs per channel: merged fast
+    if starts[0] != 0 or starts[-1] + _RECORD_HEADER.size + _MESSAGE_FIELDS.size > buffer.size:
+        return None
+    if np.any(buffer[starts] != Opcode.MESSAGE):
+        return None
+    ends = starts + _RECORD_HEADER.size + _unaligned(buffer, "<u8")[starts + 1].astype(np.int64)
+    if ends[-1] != buffer.size or np.any(ends[:-1] != starts[1:]):
+        return None
+    return starts
+
+
 class Bag:
     """All messages of a recording, read once into memory (raw CDR, decoded on demand).
 
@@ -131,6 +187,10 @@ class Bag:
         recover: Accept unfinished (truncated) files, keeping the messages of every complete
             chunk. Otherwise such a file raises :class:`InputError`.
     """
+
+    #: Locate a chunk's messages from its message indexes when they tile it (else walk it);
+    #: False walks every chunk (the reference the tests compare the indexed reading with).
+    use_indexes = True
 
     def __init__(self, path: str | Path, *, recover: bool = False) -> None:
         self.path = Path(path)
@@ -160,7 +220,8 @@ class Bag:
                 if position > length:
                     raise McapError(f"a record of {size} bytes overruns the file")
                 if opcode == Opcode.CHUNK:
-                    self._read_chunk(data, start, position, channels, schemas)
+                    indexes = _message_indexes(data, position) if self.use_indexes else []
+                    self._read_chunk(data, start, position, indexes, channels, schemas)
                 elif opcode == Opcode.MESSAGE:
                     buffer = np.frombuffer(data, np.uint8)
                     self._add_messages(buffer, np.array([start - _RECORD_HEADER.size]), channels, schemas)
@@ -186,9 +247,16 @@ class Bag:
             self.truncated.append(file)
 
     def _read_chunk(
-        self, data: bytes, start: int, end: int, channels: dict[int, Channel], schemas: dict[int, Schema]
+        self,
+        data: bytes,
+        start: int,
+        end: int,
+        indexes: list[tuple[int, int]],
+        channels: dict[int, Channel],
+        schemas: dict[int, Schema],
     ) -> None:
-        """The records of one chunk (CRC-checked; decompressed by ``mcap`` if compressed)."""
+        """The records of one chunk (CRC-checked; decompressed by ``mcap`` if compressed);
+        ``indexes``: the (start, end) of the bodies of the message index records after it."""
         _, _, uncompressed, crc, name_length = _CHUNK_FIELDS.unpack_from(data, start)
         at = start + _CHUNK_FIELDS.size
         compression = data[at : at + name_length].decode()
@@ -199,25 +267,30 @@ class Bag:
         if compression:
             chunk = Chunk.read(ReadDataStream(BytesIO(data[start:end])))
             stream, length = get_chunk_data_stream(chunk, validate_crc=True)
-            records = stream.read(length)
+            records: bytes | memoryview = stream.read(length)
         else:
-            records = data[body_start : body_start + size]
+            records = memoryview(data)[body_start : body_start + size]
             if crc and zlib.crc32(records) != crc:
                 raise McapError("chunk CRC mismatch")
             if len(records) != uncompressed:
                 raise McapError("chunk size differs from its uncompressed size")
+        buffer = np.frombuffer(records, np.uint8)
+        starts = _indexed_starts(data, buffer, indexes) if indexes else None
+        if starts is not None:
+            self._add_messages(buffer, starts, channels, schemas)
+            return
         length = len(records)
-        starts: list[int] = []  # of the message records
+        found: list[int] = []  # starts of the message records
         position = 0
         unpack = _RECORD_HEADER.unpack_from
         while position < length:
             opcode, size = unpack(records, position)
             if opcode == Opcode.MESSAGE:
-                starts.append(position)
+                found.append(position)
             elif opcode in (Opcode.CHANNEL, Opcode.SCHEMA):
-                if starts:  # the messages before it, on channels already known
-                    self._add_messages(np.frombuffer(records, np.uint8), np.array(starts), channels, schemas)
-                    starts = []
+                if found:  # the messages before it, on channels already known
+                    self._add_messages(buffer, np.array(found), channels, schemas)
+                    found = []
                 body = ReadDataStream(BytesIO(records[position + 9 : position + 9 + size]))
                 if opcode == Opcode.CHANNEL:
                     channel = Channel.read(body)
@@ -228,8 +301,8 @@ class Bag:
             position += _RECORD_HEADER.size + size
             if position > length:
                 raise McapError(f"chunk record of {size} bytes overruns its chunk")
-        if starts:
-            self._add_messages(np.frombuffer(records, np.uint8), np.array(starts), channels, schemas)
+        if found:
+            self._add_messages(buffer, np.array(found), channels, schemas)
 
     def _add_messages(
         self,
@@ -239,13 +312,13 @@ class Bag:
         schemas: dict[int, Schema],
     ) -> None:
         """Message records at ``starts`` of ``buffer``, as columns per topic, in order."""
-        fields = buffer[starts[:, None] + np.arange(_RECORD_HEADER.size + _MESSAGE_FIELDS.size)]
-        # (n, 31): opcode, record length, channel id, sequence, log time, publish time.
-        record_size = fields[:, 1:9].copy().view("<u8")[:, 0].astype(np.int64)
-        channel_id = fields[:, 9:11].copy().view("<u2")[:, 0]
-        log_ns = fields[:, 15:23].copy().view("<u8")[:, 0].astype(np.int64)
+        # Every record lies whole in ``buffer`` (its caller checked its length), so the
+        # fields after the opcode are read as unaligned numbers at the records' offsets.
+        record_size = _unaligned(buffer, "<u8")[starts + 1].astype(np.int64)
         if np.any(record_size < _MESSAGE_FIELDS.size):
             raise McapError("a message record shorter than its fields")
+        channel_id = _unaligned(buffer, "<u2")[starts + 9]
+        log_ns = _unaligned(buffer, "<u8")[starts + 15].astype(np.int64)
         order = self._records + np.arange(starts.size, dtype=np.int64)
         self._records += starts.size
         payload_start = starts + _RECORD_HEADER.size + _MESSAGE_FIELDS.size
@@ -296,8 +369,22 @@ class Bag:
         sizes = info.column("sizes")
         if sizes.size == 0 or np.any(sizes != sizes[0]):
             return info.column("log_ns"), info.column("order"), None
-        width = np.arange(int(sizes[0]))
-        rows = np.concatenate([p.buffer[p.starts[:, None] + width] for p in info.parts])
+        width = int(sizes[0])
+        rows = np.empty((sizes.size, width), np.uint8)
+        done = 0
+        for part in info.parts:
+            count = part.starts.size
+            step = np.diff(part.starts)
+            if count > 1 and step[0] >= width and np.all(step == step[0]):
+                # Evenly spaced (a topic interleaved with others in a fixed pattern): a strided
+                # view of the buffer, copied once.
+                first = int(part.starts[0])
+                rows[done : done + count] = np.lib.stride_tricks.as_strided(
+                    part.buffer[first:], (count, width), (int(step[0]), 1), writeable=False
+                )
+            else:
+                rows[done : done + count] = part.buffer[part.starts[:, None] + np.arange(width)]
+            done += count
         return info.column("log_ns"), info.column("order"), rows
 
     def resolve(self, name: str) -> str:
