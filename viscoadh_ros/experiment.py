@@ -396,9 +396,13 @@ def _node_verdicts(
     # Older stamps, per stretch between restarts: the last accepted stamp is the running
     # maximum of the candidates before (a candidate refused for its stamp is below it).
     segment = np.searchsorted(np.array([r.order for r in restarts], dtype=np.int64), order)
+    refused_so_far = np.zeros(order.size, dtype=np.bool_)
+    refused_so_far[list(reasons)] = True
+    received_segment = segment[received]
+    received_open = ~refused_so_far[received]
     for seg in np.unique(segment).tolist():
-        positions = received[np.isin(received, np.flatnonzero(segment == seg))]
-        candidates = np.array([p for p in positions.tolist() if p not in reasons], dtype=np.int64)
+        # This stretch's commands not refused yet, in the order received.
+        candidates = received[(received_segment == seg) & received_open]
         if candidates.size < 2:
             continue
         last = np.maximum.accumulate(stamps[candidates])
