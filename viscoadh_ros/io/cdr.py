@@ -19,6 +19,7 @@ from __future__ import annotations
 import functools
 import struct
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -204,23 +205,56 @@ def encode_array(
 ) -> NDArray[np.uint8]:
     """:func:`encode` as one (n, L) uint8 array: row k is the k-th payload (all of L bytes),
     for writers that take columns (``io.mcap_bulk.write_columns``)."""
-    stamps = np.asarray(stamp_ns, dtype=np.int64)
-    frame = frame_id.encode()
-    layout = _layout(type_name, len(frame))
-    records = np.zeros(stamps.shape[0], layout)
-    records["encapsulation"] = np.void(_ENCAPSULATION)
-    if _FIELDS[type_name][0]:
-        if np.any(stamps < 0):
+    return Messages(type_name, np.asarray(stamp_ns, dtype=np.int64), frame_id, fields).rows()
+
+
+@dataclass(frozen=True)
+class Messages:
+    """n messages of ``type_name`` given by their columns, as :func:`encode_array` takes them
+    (``stamp_ns`` (n,) ns >= 0; ``fields`` arrays of shape (n,) or scalars, the rest zero),
+    for a writer that serialises them straight into its own buffer (:meth:`encode_into`,
+    ``io.mcap_bulk.write_columns``) instead of into an array of payloads first."""
+
+    type_name: str
+    stamp_ns: NDArray[np.int64]
+    frame_id: str
+    fields: Mapping[str, ArrayLike]
+
+    def __len__(self) -> int:
+        return int(np.shape(self.stamp_ns)[0])
+
+    @property
+    def layout(self) -> np.dtype:
+        """The structured dtype of one payload (itemsize = its size in bytes)."""
+        return _layout(self.type_name, len(self.frame_id.encode()))
+
+    def rows(self) -> NDArray[np.uint8]:
+        """The payloads as one (n, L) uint8 array."""
+        layout = self.layout
+        records = np.zeros(len(self), layout)
+        self.encode_into(records)
+        return records.view(np.uint8).reshape(len(self), layout.itemsize)
+
+    def encode_into(self, records: np.ndarray) -> None:
+        """Serialise into ``records``: shape (n,), dtype :attr:`layout`, any strides, every
+        byte zero beforehand (padding and fields not given stay zero). Raises ValueError for a
+        negative stamp and KeyError for a field the type does not have, before writing."""
+        type_name, frame = self.type_name, self.frame_id.encode()
+        stamps = np.asarray(self.stamp_ns, dtype=np.int64)
+        known = {name for name, _ in _FIELDS[type_name][1]}
+        unknown = [name for name in self.fields if name not in known]
+        if unknown:
+            raise KeyError(f"{type_name} has no field {unknown[0]!r}")
+        stamped = _FIELDS[type_name][0]
+        if stamped and np.any(stamps < 0):
             raise ValueError(f"{type_name}: stamps must be >= 0 ns")
-        records["stamp.sec"], records["stamp.nanosec"] = np.divmod(stamps, 1_000_000_000)
-        records["frame_id.length"] = len(frame) + 1
-        records["frame_id"] = frame
-    known = {name for name, _ in _FIELDS[type_name][1]}
-    for name, values in fields.items():
-        if name not in known:
-            raise KeyError(f"{type_name} has no field {name!r}")
-        records[name] = values
-    return records.view(np.uint8).reshape(stamps.shape[0], layout.itemsize)
+        records["encapsulation"] = np.void(_ENCAPSULATION)
+        if stamped:
+            records["stamp.sec"], records["stamp.nanosec"] = np.divmod(stamps, 1_000_000_000)
+            records["frame_id.length"] = len(frame) + 1
+            records["frame_id"] = frame
+        for name, values in self.fields.items():
+            records[name] = values
 
 
 HAND_STATE = "viscoadh_msgs/msg/HandState"

@@ -43,6 +43,7 @@ from mcap.records import (
 from numpy.typing import NDArray
 
 from viscoadh_ros import __version__
+from viscoadh_ros.io import cdr
 from viscoadh_ros.io.mcap_log import (
     METADATA_NAME,
     SCENE_KEY,
@@ -71,8 +72,10 @@ _HEAD_SIZE = 31
 _CHUNK_HEAD = struct.Struct("<BQQQQII")
 
 
-def _as_rows(payloads: Sequence[bytes] | NDArray[np.uint8]) -> NDArray[np.uint8] | None:
+def _as_rows(payloads: Any) -> NDArray[np.uint8] | None:
     """The payloads as an (n, L) uint8 array when they all have one length, else None."""
+    if isinstance(payloads, cdr.Messages):
+        return payloads.rows()
     if isinstance(payloads, np.ndarray):
         return payloads if payloads.ndim == 2 else None
     if not len(payloads):
@@ -83,32 +86,46 @@ def _as_rows(payloads: Sequence[bytes] | NDArray[np.uint8]) -> NDArray[np.uint8]
     return np.frombuffer(b"".join(payloads), np.uint8).reshape(len(payloads), length)
 
 
+def _fixed(payloads: Any) -> NDArray[np.uint8] | cdr.Messages | None:
+    """Payloads of one length as they can be written in place (an (n, L) array or the
+    messages' columns), else None."""
+    return payloads if isinstance(payloads, cdr.Messages) else _as_rows(payloads)
+
+
+def _size(payloads: NDArray[np.uint8] | cdr.Messages) -> int:
+    return payloads.layout.itemsize if isinstance(payloads, cdr.Messages) else payloads.shape[1]
+
+
 def _head_layout(length: int) -> np.dtype:
     """One message record with a payload of ``length`` bytes (no padding)."""
     return np.dtype(_MESSAGE_HEAD + [("data", f"V{length}")] if length else _MESSAGE_HEAD)
 
 
-def _fill(records: np.ndarray, channel: int, log_ns: NDArray[np.int64], rows: NDArray[np.uint8]) -> None:
-    """Write message records (a structured array of :func:`_head_layout`) in place."""
-    n, length = rows.shape
+def _fill(
+    records: np.ndarray, channel: int, log_ns: NDArray[np.int64], payloads: NDArray[np.uint8] | cdr.Messages
+) -> None:
+    """Write message records (a zeroed structured array of :func:`_head_layout`) in place."""
+    n, length = len(log_ns), _size(payloads)
     records["opcode"] = Opcode.MESSAGE
     records["length"] = _HEAD_SIZE - 9 + length
     records["channel"] = channel
     records["sequence"] = np.arange(n, dtype=np.uint32)
     records["log_time"] = log_ns
     records["publish_time"] = log_ns
-    if length:
-        records["data"] = rows.view(f"V{length}").reshape(n)
+    if isinstance(payloads, cdr.Messages):
+        payloads.encode_into(records["data"].view(payloads.layout))
+    elif length:
+        records["data"] = payloads.view(f"V{length}").reshape(n)
 
 
 def _records(channel: int, log_ns: NDArray[np.int64], payloads: Any) -> tuple[NDArray[np.uint8], NDArray]:
     """``(bytes, sizes)``: the message records of one topic, concatenated, and each one's size."""
-    rows = _as_rows(payloads)
+    fixed = _fixed(payloads)
     n = len(log_ns)
-    if rows is not None:
-        layout = _head_layout(rows.shape[1])
-        records = np.empty(n, layout)
-        _fill(records, channel, log_ns, rows)
+    if fixed is not None:
+        layout = _head_layout(_size(fixed))
+        records = np.zeros(n, layout)
+        _fill(records, channel, log_ns, fixed)
         return records.view(np.uint8), np.full(n, layout.itemsize, dtype=np.int64)
     # Payloads of several lengths: one small header per message, joined in one pass.
     heads = struct.Struct("<BQHIQQ")
@@ -121,29 +138,32 @@ def _records(channel: int, log_ns: NDArray[np.int64], payloads: Any) -> tuple[ND
 
 
 def _side_by_side(
-    log_ns: list[NDArray[np.int64]], rows: list[NDArray[np.uint8] | None]
+    log_ns: list[NDArray[np.int64]], payloads: list[Any]
 ) -> tuple[NDArray[np.uint8], NDArray[np.int64], NDArray[np.int64], NDArray[np.int64]] | None:
     """The ordered stream of :func:`_ordered` built in one pass when every topic has payloads
     of one length on the same non-decreasing log times (a state and its wrench per input):
-    the k-th records of the topics side by side, one structured row per k, filled in place.
-    None when the topics are not like that."""
+    the k-th records of the topics side by side, one structured row per k, filled (and the
+    messages given as columns serialised) in place. None when the topics are not like that."""
     n = log_ns[0].size
-    if len(rows) < 2 or any(r is None for r in rows) or n == 0:
+    if len(payloads) < 2 or n == 0:
         return None
     if not all(ns.shape == (n,) and np.array_equal(ns, log_ns[0]) for ns in log_ns[1:]):
         return None
     if np.any(np.diff(log_ns[0]) < 0):
         return None
-    layouts = [_head_layout(r.shape[1]) for r in rows]  # type: ignore[union-attr]
+    fixed = [_fixed(p) for p in payloads]
+    if any(f is None for f in fixed):
+        return None
+    layouts = [_head_layout(_size(f)) for f in fixed]  # type: ignore[arg-type]
     offsets = np.cumsum([0] + [lay.itemsize for lay in layouts])
-    names = [f"t{t}" for t in range(len(rows))]
+    names = [f"t{t}" for t in range(len(fixed))]
     row = np.dtype(
         {"names": names, "formats": layouts, "offsets": offsets[:-1].tolist(), "itemsize": int(offsets[-1])}
     )
-    records = np.empty(n, row)
-    for t, (name, data) in enumerate(zip(names, rows, strict=True)):
+    records = np.zeros(n, row)
+    for t, (name, data) in enumerate(zip(names, fixed, strict=True)):
         _fill(records[name], t + 1, log_ns[0], data)  # type: ignore[arg-type]
-    count = len(rows)
+    count = len(fixed)
     sizes = np.tile(np.array([lay.itemsize for lay in layouts], dtype=np.int64), n)
     return records.view(np.uint8), sizes, np.tile(np.arange(count), n), np.repeat(log_ns[0], count)
 
@@ -157,8 +177,10 @@ def write_columns(
 ) -> None:
     """Write a finished MCAP file of whole topics at once (see the module docstring).
 
-    ``TopicData.payloads`` may be a list of CDR payloads or an (n, L) uint8 array of n
-    payloads of L bytes (:func:`viscoadh_ros.io.cdr.encode_array`), the fast case.
+    ``TopicData.payloads`` may be a list of CDR payloads, an (n, L) uint8 array of n
+    payloads of L bytes (:func:`viscoadh_ros.io.cdr.encode_array`), or a
+    :class:`viscoadh_ros.io.cdr.Messages` (the columns of n messages, serialised straight
+    into the file's records: the fast case).
     """
     for data in topics:
         if len(data.log_ns) != len(data.payloads):
@@ -167,7 +189,7 @@ def write_columns(
     if any(np.any(ns < 0) for ns in log_ns):
         raise ValueError("log times must be >= 0 ns")
     # Every topic's records in one buffer in log-time order (ties as write_mcap breaks them).
-    ordered = _side_by_side(log_ns, [_as_rows(d.payloads) for d in topics]) if topics else None
+    ordered = _side_by_side(log_ns, [d.payloads for d in topics]) if topics else None
     if ordered is None:
         built = [
             _records(t + 1, ns, d.payloads) for t, (ns, d) in enumerate(zip(log_ns, topics, strict=True))
