@@ -1,16 +1,18 @@
 """Side-by-side cost of `viscoadh replay` and its stages, this checkout against a git ref, in one
 process (issue 13's before/after for the replay paths).
 
-    .venv/bin/python benchmarks/replay_ab.py [REF] [--seconds 60] [--repeats 7]
+    .venv/bin/python benchmarks/replay_ab.py [REF] [--new REF2] [--seconds 60] [--repeats 7]
 
 REF (default ``main``) is read with ``git show``: its replay-side modules (io/bag.py, io/cdr.py,
 io/mcap_bulk.py, experiment.py, cli/replay.py) are loaded under the package name ``_ab_old``
-beside the current ones, both on the current core (the simulator is the same object code), so
-the two paths run alternately on the same recording (a node-style log of 1 kHz depth commands
-and wrenches, `bench.replay_speed.record_stream`) and only the replay-side code differs.
-Prints the median of the repeats per stage, in us per command, and the ratio; also the bare
+beside the current ones (or beside REF2's, ``--new``, loaded as ``_ab_new``: one change at a
+time), both on the current core (the simulator is the same object code), so the two paths run
+alternately on the same recording (a node-style log of 1 kHz depth commands and wrenches,
+`bench.replay_speed.record_stream`) and only the replay-side code differs. Prints the median
+of the repeats per stage, in us per command, and the ratio; also the bare
 `ContactSimulator.step_depths` over the same depth history (what the simulate stage would cost
-with no Python around the kernel). Compare only the ratios of one sitting.
+with no Python around the kernel), and whether both sides wrote the same output bytes.
+Compare only the ratios of one sitting.
 """
 
 from __future__ import annotations
@@ -40,9 +42,9 @@ MODULES = {
 }
 
 
-def load_old(ref: str, folder: Path) -> dict[str, ModuleType]:
-    """The replay-side modules of ``ref``, importable as ``_ab_old.<name>``."""
-    package = folder / "_ab_old"
+def load_old(ref: str, folder: Path, alias: str = "_ab_old") -> dict[str, ModuleType]:
+    """The replay-side modules of ``ref``, importable as ``<alias>.<name>``."""
+    package = folder / alias
     for sub in ("", "io", "cli"):
         (package / sub).mkdir(parents=True, exist_ok=True)
         (package / sub / "__init__.py").write_text("")
@@ -51,13 +53,14 @@ def load_old(ref: str, folder: Path) -> dict[str, ModuleType]:
         source = subprocess.run(
             ["git", "show", f"{ref}:{path}"], cwd=ROOT, check=True, capture_output=True, text=True
         ).stdout
-        source = re.sub(rf"\bviscoadh_ros\.({names})\b", r"_ab_old.\1", source)
+        source = re.sub(rf"\bviscoadh_ros\.({names})\b", rf"{alias}.\1", source)
         source = re.sub(
-            r"from viscoadh_ros\.io import (bag|cdr|mcap_bulk)\b", r"from _ab_old.io import \1", source
+            r"from viscoadh_ros\.io import (bag|cdr|mcap_bulk)\b", rf"from {alias}.io import \1", source
         )
         (package / (name.replace(".", "/") + ".py")).write_text(source)
-    sys.path.insert(0, str(folder))
-    return {name: importlib.import_module(f"_ab_old.{name}") for name in MODULES}
+    if str(folder) not in sys.path:
+        sys.path.insert(0, str(folder))
+    return {name: importlib.import_module(f"{alias}.{name}") for name in MODULES}
 
 
 def current() -> dict[str, ModuleType]:
@@ -101,6 +104,7 @@ def stages(mods: dict[str, ModuleType], bag_path: Path, out: Path) -> dict[str, 
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("ref", nargs="?", default="main")
+    parser.add_argument("--new", help="a second ref in place of this checkout")
     parser.add_argument("--seconds", type=float, default=60.0)
     parser.add_argument("--repeats", type=int, default=7)
     options = parser.parse_args()
@@ -114,7 +118,11 @@ def main() -> int:
         record_stream(bag_path, options.seconds)
         sides = {
             "old": stages(load_old(options.ref, folder), bag_path, folder / "old.mcap"),
-            "new": stages(current(), bag_path, folder / "new.mcap"),
+            "new": stages(
+                current() if options.new is None else load_old(options.new, folder, "_ab_new"),
+                bag_path,
+                folder / "new.mcap",
+            ),
         }
         experiment, contact = sides["new"]["_experiment"], sides["new"]["_contact"]
         times = experiment.time(experiment.input_ns)
@@ -134,7 +142,7 @@ def main() -> int:
         n = experiment.input_ns.size
         med = {key: float(np.median(v)) / n * 1e6 for key, v in samples.items()}
         print(f"{n} commands ({options.seconds:g} s at 1 kHz), median of {options.repeats}, us per command")
-        print(f"| stage | {options.ref} | this checkout | ratio |")
+        print(f"| stage | {options.ref} | {options.new or 'this checkout'} | ratio |")
         print("|---|---|---|---|")
         for name in names:
             old, new = med[("old", name)], med[("new", name)]
@@ -149,6 +157,8 @@ def main() -> int:
                 f"{rest:.3f} us/command; run_model - step_depths alone "
                 f"{med[(side, 'simulate (run_model)')] - med[('new', 'step_depths alone')]:.3f} us/command"
             )
+        same = (folder / "old.mcap").read_bytes() == (folder / "new.mcap").read_bytes()
+        print(f"output files byte-identical: {same}")
     return 0
 
 
