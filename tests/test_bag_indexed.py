@@ -5,6 +5,7 @@ walk whenever the indexes do not tile the chunk."""
 from __future__ import annotations
 
 import struct
+import zlib
 from pathlib import Path
 from typing import Any
 
@@ -156,3 +157,38 @@ def test_damaged_indexes_fall_back_to_the_walk(
     used = _count_indexed(monkeypatch)
     assert _contents(path, indexed=True) == _contents(path, indexed=False)
     assert used[0] is False, "the damaged chunk is walked"
+
+
+@pytest.mark.parametrize("damage", ["channel", "crc"])
+def test_a_bad_chunk_keeps_the_chunks_before_it(tmp_path: Path, damage: str) -> None:
+    """A message on an undefined channel (CRC fixed up), or a CRC mismatch, in the third
+    chunk: refused without recover; with it, the messages of the first two chunks."""
+    from viscoadh_ros.core.errors import InputError
+
+    path = tmp_path / "stream.mcap"
+    record_stream(path, 10.0)
+    data = bytearray(path.read_bytes())
+    chunks, position = [], 8
+    while True:
+        opcode, size = struct.unpack_from("<BQ", data, position)
+        if opcode == 0x06:
+            chunks.append(position)
+        if opcode == 0x02:
+            break
+        position += 9 + size
+    assert len(chunks) >= 3
+    head = chunks[2] + 9 + 8 + 8 + 8  # the chunk's uncompressed CRC
+    records = head + 4 + 4 + 8  # no compression name; records length; first message record
+    length = struct.unpack_from("<Q", data, head + 8)[0]
+    if damage == "channel":
+        struct.pack_into("<H", data, records + 9, 99)
+        struct.pack_into("<I", data, head, zlib.crc32(bytes(data[records : records + length])))
+    else:
+        data[records + 40] ^= 0xFF
+    path.write_bytes(bytes(data))
+    with pytest.raises(InputError, match="truncated or damaged"):
+        Bag(path)
+    kept = _contents(path, indexed=True, recover=True)
+    assert kept == _contents(path, indexed=False, recover=True)
+    count = sum(len(m[0]) for m in kept["messages"].values())
+    assert 0 < count < 20000 and kept["truncated"] == [path]

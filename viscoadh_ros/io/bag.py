@@ -208,6 +208,12 @@ class Bag:
         data = file.read_bytes()
         if not data.startswith(_MAGIC):
             raise InputError(f"{str(file)!r} is not an MCAP file")
+        # Message records of uncompressed chunks (and outside chunks) lie in ``data`` itself:
+        # their file offsets are gathered chunk by chunk and added as columns in one pass
+        # (`_flush`) before anything that could change what they mean (a channel or schema
+        # record) and at the end.
+        self._buffer = np.frombuffer(data, np.uint8)
+        self._pending: list[NDArray[np.int64]] = []
         finished = False
         try:
             position, length = len(_MAGIC), len(data)
@@ -223,9 +229,10 @@ class Bag:
                     indexes = _message_indexes(data, position) if self.use_indexes else []
                     self._read_chunk(data, start, position, indexes, channels, schemas)
                 elif opcode == Opcode.MESSAGE:
-                    buffer = np.frombuffer(data, np.uint8)
-                    self._add_messages(buffer, np.array([start - _RECORD_HEADER.size]), channels, schemas)
+                    self._pending.append(np.array([start - _RECORD_HEADER.size]))
                 elif opcode in _RECORD_TYPES:
+                    if opcode != Opcode.METADATA:
+                        self._flush(channels, schemas)
                     record = _RECORD_TYPES[opcode].read(ReadDataStream(BytesIO(data[start:position])))
                     if opcode == Opcode.SCHEMA:
                         schemas[record.id] = record
@@ -235,6 +242,7 @@ class Bag:
                         self.metadata.setdefault(record.name, {}).update(record.metadata)
                 elif opcode == Opcode.FOOTER:
                     finished = True
+            self._flush(channels, schemas)
             if not finished:
                 raise McapError("the file ends before its footer")
         except (McapError, struct.error, ValueError, EOFError) as exc:
@@ -243,6 +251,11 @@ class Bag:
                     f"{str(file)!r} is truncated or damaged ({type(exc).__name__}: {exc}); "
                     "pass --recover to use the messages up to its last complete chunk"
                 ) from None
+            try:  # the complete chunks before the damage
+                self._flush(channels, schemas)
+            except McapError:
+                pass
+        self._pending = []
         if not finished:
             self.truncated.append(file)
 
@@ -265,6 +278,7 @@ class Bag:
         if body_start + size > end:
             raise McapError("chunk records overrun the chunk")
         if compression:
+            self._flush(channels, schemas)
             chunk = Chunk.read(ReadDataStream(BytesIO(data[start:end])))
             stream, length = get_chunk_data_stream(chunk, validate_crc=True)
             records: bytes | memoryview = stream.read(length)
@@ -277,7 +291,7 @@ class Bag:
         buffer = np.frombuffer(records, np.uint8)
         starts = _indexed_starts(data, buffer, indexes) if indexes else None
         if starts is not None:
-            self._add_messages(buffer, starts, channels, schemas)
+            self._messages(compression, body_start, buffer, starts, channels, schemas)
             return
         length = len(records)
         found: list[int] = []  # starts of the message records
@@ -289,8 +303,9 @@ class Bag:
                 found.append(position)
             elif opcode in (Opcode.CHANNEL, Opcode.SCHEMA):
                 if found:  # the messages before it, on channels already known
-                    self._add_messages(buffer, np.array(found), channels, schemas)
+                    self._messages(compression, body_start, buffer, np.array(found), channels, schemas)
                     found = []
+                self._flush(channels, schemas)
                 body = ReadDataStream(BytesIO(records[position + 9 : position + 9 + size]))
                 if opcode == Opcode.CHANNEL:
                     channel = Channel.read(body)
@@ -302,7 +317,35 @@ class Bag:
             if position > length:
                 raise McapError(f"chunk record of {size} bytes overruns its chunk")
         if found:
-            self._add_messages(buffer, np.array(found), channels, schemas)
+            self._messages(compression, body_start, buffer, np.array(found), channels, schemas)
+
+    def _messages(
+        self,
+        compression: str,
+        body_start: int,
+        buffer: NDArray[np.uint8],
+        starts: NDArray[np.int64],
+        channels: dict[int, Channel],
+        schemas: dict[int, Schema],
+    ) -> None:
+        """Message records at ``starts`` of a chunk's records ``buffer``: added now from a
+        decompressed buffer, else kept as file offsets for `_flush`."""
+        if compression:
+            self._add_messages(buffer, starts, channels, schemas)
+        else:
+            self._pending.append(starts + body_start)
+
+    def _flush(self, channels: dict[int, Channel], schemas: dict[int, Schema]) -> None:
+        """Add the pending message records of the file in one pass; when that fails (a bad
+        record or channel), chunk by chunk, so those before the bad one are kept."""
+        batch, self._pending = self._pending, []
+        if not batch:
+            return
+        try:
+            self._add_messages(self._buffer, np.concatenate(batch), channels, schemas)
+        except McapError:
+            for starts in batch:
+                self._add_messages(self._buffer, starts, channels, schemas)
 
     def _add_messages(
         self,
@@ -318,13 +361,17 @@ class Bag:
         if np.any(record_size < _MESSAGE_FIELDS.size):
             raise McapError("a message record shorter than its fields")
         channel_id = _unaligned(buffer, "<u2")[starts + 9]
+        ids = np.unique(channel_id).tolist()
+        unknown = [cid for cid in ids if cid not in channels]
+        if unknown:  # before anything is added
+            raise McapError(f"message on channel {unknown[0]}, which is not defined before it")
         log_ns = _unaligned(buffer, "<u8")[starts + 15].astype(np.int64)
         order = self._records + np.arange(starts.size, dtype=np.int64)
         self._records += starts.size
         payload_start = starts + _RECORD_HEADER.size + _MESSAGE_FIELDS.size
         payload_size = record_size - _MESSAGE_FIELDS.size
-        for cid in np.unique(channel_id).tolist():
-            mine = channel_id == cid
+        for cid in ids:
+            mine = channel_id == cid if len(ids) > 1 else slice(None)
             self._topic(cid, channels, schemas).parts.append(
                 _Part(buffer, payload_start[mine], payload_size[mine], log_ns[mine], order[mine])
             )
@@ -370,20 +417,15 @@ class Bag:
         if sizes.size == 0 or np.any(sizes != sizes[0]):
             return info.column("log_ns"), info.column("order"), None
         width = int(sizes[0])
+        # Each part's payloads gathered as one L-byte item per message (an unaligned view of
+        # its buffer), straight into the (n, L) array.
         rows = np.empty((sizes.size, width), np.uint8)
+        items = rows.view(f"V{width}").reshape(sizes.size) if width else None
         done = 0
         for part in info.parts:
             count = part.starts.size
-            step = np.diff(part.starts)
-            if count > 1 and step[0] >= width and np.all(step == step[0]):
-                # Evenly spaced (a topic interleaved with others in a fixed pattern): a strided
-                # view of the buffer, copied once.
-                first = int(part.starts[0])
-                rows[done : done + count] = np.lib.stride_tricks.as_strided(
-                    part.buffer[first:], (count, width), (int(step[0]), 1), writeable=False
-                )
-            else:
-                rows[done : done + count] = part.buffer[part.starts[:, None] + np.arange(width)]
+            if items is not None:
+                items[done : done + count] = _unaligned(part.buffer, f"V{width}")[part.starts]
             done += count
         return info.column("log_ns"), info.column("order"), rows
 
