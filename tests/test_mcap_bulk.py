@@ -81,3 +81,18 @@ def test_empty_topics(tmp_path: Path) -> None:
         reader = make_reader(stream)
         assert list(reader.iter_messages()) == []
         assert {c.topic for c in reader.get_summary().channels.values()} == {"/c/state", "/c/wrench"}
+
+
+def test_decode_only_the_fields_asked() -> None:
+    stamps = 5_000_000_000 + np.arange(4)
+    rows = cdr.encode_array(
+        cdr.WRENCH, stamps, "f", {"wrench.force.z": np.arange(4.0), "wrench.torque.x": 2.0}
+    )
+    full = cdr.decode(cdr.WRENCH, rows)
+    some = cdr.decode(cdr.WRENCH, rows, ["wrench.force.z"])
+    assert full is not None and some is not None
+    assert set(some) == {"wrench.force.z", "stamp_ns"}
+    for name in some:
+        np.testing.assert_array_equal(some[name], full[name])
+    with pytest.raises(KeyError, match="no field"):
+        cdr.decode(cdr.WRENCH, rows, ["wrench.force.w"])

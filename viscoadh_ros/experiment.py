@@ -149,7 +149,7 @@ def _read_topic(bag: Bag, topic: str) -> tuple[NDArray[np.int64], NDArray[np.int
     else message by message through rclpy."""
     type_name = bag.topics[topic]
     log_ns, order, rows = bag.rows(topic)
-    columns = None if rows is None else cdr.decode(type_name, rows)
+    columns = None if rows is None else cdr.decode(type_name, rows, _VALUE_FIELDS[type_name])
     if columns is None:
         messages = list(bag.messages([topic]))
         log_ns = np.array([m.log_time_ns for m in messages], dtype=np.int64)

@@ -156,10 +156,13 @@ def parse_command(payload: bytes) -> tuple[int, int, int, float, float] | None:
     return sec, nanosec, mode, depth, force
 
 
-def decode(type_name: str, payloads: Sequence[bytes] | NDArray[np.uint8]) -> dict[str, NDArray] | None:
+def decode(
+    type_name: str, payloads: Sequence[bytes] | NDArray[np.uint8], fields: Sequence[str] | None = None
+) -> dict[str, NDArray] | None:
     """Every field of ``payloads`` (n CDR messages of ``type_name``, or an (n, L) uint8 array of
-    them, see ``Bag.rows``) as arrays of shape (n,), plus ``stamp_ns`` (int64, ns) for stamped
-    types; None when they cannot be read in bulk."""
+    them, see ``Bag.rows``), or only ``fields``, as arrays of shape (n,), plus ``stamp_ns``
+    (int64, ns) for stamped types; None when they cannot be read in bulk. KeyError for a field
+    the type does not have."""
     if type_name not in _FIELDS or not len(payloads):
         return None
     if isinstance(payloads, np.ndarray):
@@ -184,7 +187,12 @@ def decode(type_name: str, payloads: Sequence[bytes] | NDArray[np.uint8]) -> dic
     records = head.view(layout).reshape(len(head))
     if stamped and np.any(records["frame_id.length"] != frame + 1):
         return None
-    columns = {name: records[name].copy() for name, _ in _FIELDS[type_name][1]}
+    known = [name for name, _ in _FIELDS[type_name][1]]
+    if fields is not None:
+        unknown = [name for name in fields if name not in known]
+        if unknown:
+            raise KeyError(f"{type_name} has no field {unknown[0]!r}")
+    columns = {name: records[name].copy() for name in (known if fields is None else fields)}
     if stamped:
         columns["stamp_ns"] = records["stamp.sec"].astype(np.int64) * 1_000_000_000 + records["stamp.nanosec"]
     return columns
