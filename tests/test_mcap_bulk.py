@@ -9,14 +9,16 @@ import numpy as np
 import pytest
 from mcap.reader import make_reader
 
-from viscoadh_ros.io import cdr
+from viscoadh_ros.io import cdr, mcap_bulk
 from viscoadh_ros.io.bag import Bag
 from viscoadh_ros.io.mcap_bulk import write_columns
 from viscoadh_ros.io.mcap_log import TopicData
 
 
 @pytest.mark.parametrize("n", [1, 5, 3000])
-def test_payload_forms_write_the_same_bytes(tmp_path: Path, n: int) -> None:
+def test_payload_forms_write_the_same_bytes(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, n: int) -> None:
+    """Also the same bytes as the general path (every topic's records built whole, then put
+    in log-time order), which side-by-side topics do not take."""
     rng = np.random.default_rng(n)
     stamps = 2_000_000_000 + 1_000_000 * np.arange(n)
     state = {
@@ -45,7 +47,21 @@ def test_payload_forms_write_the_same_bytes(tmp_path: Path, n: int) -> None:
             chunk_size=4096,
         )
         files[form] = path.read_bytes()
-    assert files["messages"] == files["rows"] == files["bytes"]
+    with monkeypatch.context() as patch:
+        patch.setattr(mcap_bulk._SideBySide, "plan", staticmethod(lambda *args: None))
+        for form, make in forms.items():
+            path = tmp_path / f"{form}_general.mcap"
+            write_columns(
+                path,
+                [
+                    TopicData("/c/state", cdr.CONTACT_STATE, stamps, make(cdr.CONTACT_STATE, "frame", state)),
+                    TopicData("/c/wrench", cdr.WRENCH, stamps, make(cdr.WRENCH, "frame", wrench)),
+                ],
+                scene={"a": 1},
+                chunk_size=4096,
+            )
+            files[f"{form} general"] = path.read_bytes()
+    assert len(set(files.values())) == 1, "one file whatever the form and path"
     bag = Bag(tmp_path / "messages.mcap")
     columns = cdr.decode(cdr.CONTACT_STATE, bag.rows("/c/state")[2])
     assert columns is not None

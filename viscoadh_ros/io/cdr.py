@@ -243,26 +243,31 @@ class Messages:
         self.encode_into(records)
         return records.view(np.uint8).reshape(len(self), layout.itemsize)
 
-    def encode_into(self, records: np.ndarray) -> None:
-        """Serialise into ``records``: shape (n,), dtype :attr:`layout`, any strides, every
-        byte zero beforehand (padding and fields not given stay zero). Raises ValueError for a
-        negative stamp and KeyError for a field the type does not have, before writing."""
-        type_name, frame = self.type_name, self.frame_id.encode()
-        stamps = np.asarray(self.stamp_ns, dtype=np.int64)
-        known = {name for name, _ in _FIELDS[type_name][1]}
+    def check(self) -> None:
+        """ValueError for a negative stamp, KeyError for a field the type does not have."""
+        known = {name for name, _ in _FIELDS[self.type_name][1]}
         unknown = [name for name in self.fields if name not in known]
         if unknown:
-            raise KeyError(f"{type_name} has no field {unknown[0]!r}")
-        stamped = _FIELDS[type_name][0]
-        if stamped and np.any(stamps < 0):
-            raise ValueError(f"{type_name}: stamps must be >= 0 ns")
+            raise KeyError(f"{self.type_name} has no field {unknown[0]!r}")
+        if _FIELDS[self.type_name][0] and np.any(np.asarray(self.stamp_ns) < 0):
+            raise ValueError(f"{self.type_name}: stamps must be >= 0 ns")
+
+    def encode_into(self, records: np.ndarray, first: int = 0) -> None:
+        """Serialise messages ``first`` to ``first + len(records)`` into ``records``: shape
+        (k,), dtype :attr:`layout`, any strides, every byte zero beforehand (padding and
+        fields not given stay zero). Checks (:meth:`check`) before writing."""
+        self.check()
+        end = first + len(records)
+        frame = self.frame_id.encode()
+        stamps = np.asarray(self.stamp_ns, dtype=np.int64)[first:end]
         records["encapsulation"] = np.void(_ENCAPSULATION)
-        if stamped:
+        if _FIELDS[self.type_name][0]:
             records["stamp.sec"], records["stamp.nanosec"] = np.divmod(stamps, 1_000_000_000)
             records["frame_id.length"] = len(frame) + 1
             records["frame_id"] = frame
         for name, values in self.fields.items():
-            records[name] = values
+            values = np.asarray(values)
+            records[name] = values[first:end] if values.ndim else values
 
 
 HAND_STATE = "viscoadh_msgs/msg/HandState"

@@ -102,20 +102,25 @@ def _head_layout(length: int) -> np.dtype:
 
 
 def _fill(
-    records: np.ndarray, channel: int, log_ns: NDArray[np.int64], payloads: NDArray[np.uint8] | cdr.Messages
+    records: np.ndarray,
+    channel: int,
+    log_ns: NDArray[np.int64],
+    payloads: NDArray[np.uint8] | cdr.Messages,
+    first: int = 0,
 ) -> None:
-    """Write message records (a zeroed structured array of :func:`_head_layout`) in place."""
-    n, length = len(log_ns), _size(payloads)
+    """Write messages ``first`` to ``first + len(records)`` of a topic as message records (a
+    zeroed structured array of :func:`_head_layout`) in place."""
+    end, length = first + len(records), _size(payloads)
     records["opcode"] = Opcode.MESSAGE
     records["length"] = _HEAD_SIZE - 9 + length
     records["channel"] = channel
-    records["sequence"] = np.arange(n, dtype=np.uint32)
-    records["log_time"] = log_ns
-    records["publish_time"] = log_ns
+    records["sequence"] = np.arange(first, end, dtype=np.uint32)
+    records["log_time"] = log_ns[first:end]
+    records["publish_time"] = log_ns[first:end]
     if isinstance(payloads, cdr.Messages):
-        payloads.encode_into(records["data"].view(payloads.layout))
+        payloads.encode_into(records["data"].view(payloads.layout), first)
     elif length:
-        records["data"] = payloads.view(f"V{length}").reshape(n)
+        records["data"] = payloads[first:end].view(f"V{length}").reshape(end - first)
 
 
 def _records(channel: int, log_ns: NDArray[np.int64], payloads: Any) -> tuple[NDArray[np.uint8], NDArray]:
@@ -137,35 +142,64 @@ def _records(channel: int, log_ns: NDArray[np.int64], payloads: Any) -> tuple[ND
     return np.frombuffer(b"".join(parts), np.uint8), sizes
 
 
-def _side_by_side(
-    log_ns: list[NDArray[np.int64]], payloads: list[Any]
-) -> tuple[NDArray[np.uint8], NDArray[np.int64], NDArray[np.int64], NDArray[np.int64]] | None:
-    """The ordered stream of :func:`_ordered` built in one pass when every topic has payloads
-    of one length on the same non-decreasing log times (a state and its wrench per input):
-    the k-th records of the topics side by side, one structured row per k, filled (and the
-    messages given as columns serialised) in place. None when the topics are not like that."""
-    n = log_ns[0].size
-    if len(payloads) < 2 or n == 0:
-        return None
-    if not all(ns.shape == (n,) and np.array_equal(ns, log_ns[0]) for ns in log_ns[1:]):
-        return None
-    if np.any(np.diff(log_ns[0]) < 0):
-        return None
-    fixed = [_fixed(p) for p in payloads]
-    if any(f is None for f in fixed):
-        return None
-    layouts = [_head_layout(_size(f)) for f in fixed]  # type: ignore[arg-type]
-    offsets = np.cumsum([0] + [lay.itemsize for lay in layouts])
-    names = [f"t{t}" for t in range(len(fixed))]
-    row = np.dtype(
-        {"names": names, "formats": layouts, "offsets": offsets[:-1].tolist(), "itemsize": int(offsets[-1])}
-    )
-    records = np.zeros(n, row)
-    for t, (name, data) in enumerate(zip(names, fixed, strict=True)):
-        _fill(records[name], t + 1, log_ns[0], data)  # type: ignore[arg-type]
-    count = len(fixed)
-    sizes = np.tile(np.array([lay.itemsize for lay in layouts], dtype=np.int64), n)
-    return records.view(np.uint8), sizes, np.tile(np.arange(count), n), np.repeat(log_ns[0], count)
+class _SideBySide:
+    """Topics whose payloads all have one length, on the same non-decreasing log times (a
+    state and its wrench per input): in file order the k-th records of the topics lie side by
+    side, one structured row per k. A chunk's bytes are built when it is written, into one
+    reused block of rows (filled and, for messages given as columns, serialised in place),
+    so the file is never held whole and each row is written while it is in the cache."""
+
+    def __init__(self, log_ns: NDArray[np.int64], fixed: list[NDArray[np.uint8] | cdr.Messages]) -> None:
+        self.log_ns, self.fixed = log_ns, fixed
+        layouts = [_head_layout(_size(f)) for f in fixed]
+        offsets = np.cumsum([0] + [lay.itemsize for lay in layouts])
+        self.names = [f"t{t}" for t in range(len(fixed))]
+        self.row = np.dtype(
+            {
+                "names": self.names,
+                "formats": layouts,
+                "offsets": offsets[:-1].tolist(),
+                "itemsize": int(offsets[-1]),
+            }
+        )
+        n, count = log_ns.size, len(fixed)
+        self.count = count
+        self.sizes = np.tile(np.array([lay.itemsize for lay in layouts], dtype=np.int64), n)
+        self.which = np.tile(np.arange(count), n)
+        self.times = np.repeat(log_ns, count)
+        self._block = np.empty(0, self.row)
+
+    @staticmethod
+    def plan(log_ns: list[NDArray[np.int64]], payloads: list[Any]) -> _SideBySide | None:
+        """The topics as side-by-side rows, or None when they are not like that."""
+        n = log_ns[0].size
+        if len(payloads) < 2 or n == 0:
+            return None
+        if not all(ns.shape == (n,) and np.array_equal(ns, log_ns[0]) for ns in log_ns[1:]):
+            return None
+        if np.any(np.diff(log_ns[0]) < 0):
+            return None
+        fixed = [_fixed(p) for p in payloads]
+        if any(f is None for f in fixed):
+            return None
+        for f in fixed:
+            if isinstance(f, cdr.Messages):
+                f.check()  # before the file is opened
+        return _SideBySide(log_ns[0], fixed)  # type: ignore[arg-type]
+
+    def chunk(self, lo: int, hi: int, first: int, end: int) -> memoryview:
+        """The bytes of records ``lo`` to ``hi`` (file-order indexes), stream offsets ``first``
+        to ``end``; valid until the next call."""
+        k0, k1 = lo // self.count, (hi - 1) // self.count + 1
+        if self._block.size < k1 - k0:
+            self._block = np.empty(k1 - k0, self.row)
+        block = self._block[: k1 - k0]
+        raw = block.view(np.uint8)
+        raw[:] = 0
+        for t, (name, data) in enumerate(zip(self.names, self.fixed, strict=True)):
+            _fill(block[name], t + 1, self.log_ns, data, k0)
+        offset = first - k0 * self.row.itemsize
+        return memoryview(raw[offset : offset + end - first])
 
 
 def write_columns(
@@ -188,14 +222,21 @@ def write_columns(
     log_ns = [np.asarray(d.log_ns, dtype=np.int64) for d in topics]
     if any(np.any(ns < 0) for ns in log_ns):
         raise ValueError("log times must be >= 0 ns")
-    # Every topic's records in one buffer in log-time order (ties as write_mcap breaks them).
-    ordered = _side_by_side(log_ns, [d.payloads for d in topics]) if topics else None
-    if ordered is None:
+    # Every topic's records in log-time order (ties as write_mcap breaks them): built chunk by
+    # chunk for side-by-side topics, else in one buffer.
+    plan = _SideBySide.plan(log_ns, [d.payloads for d in topics]) if topics else None
+    if plan is not None:
+        sizes, which, times = plan.sizes, plan.which, plan.times
+        chunk_bytes = plan.chunk
+    else:
         built = [
             _records(t + 1, ns, d.payloads) for t, (ns, d) in enumerate(zip(log_ns, topics, strict=True))
         ]
-        ordered = _ordered(log_ns, built)
-    stream, sizes, which, times = ordered
+        stream, sizes, which, times = _ordered(log_ns, built)
+
+        def chunk_bytes(lo: int, hi: int, first: int, end: int) -> memoryview:
+            return memoryview(stream[first:end])
+
     starts = np.cumsum(sizes) - sizes  # of each message record in the ordered stream
 
     builder = RecordBuilder()
@@ -257,7 +298,7 @@ def write_columns(
             position, crc = len(head), zlib.crc32(head)
             for c, (lo, hi) in enumerate(zip(firsts.tolist(), lasts.tolist(), strict=True)):
                 first, end = int(starts[lo]), int(starts[hi - 1] + sizes[hi - 1])
-                data = memoryview(stream[first:end])
+                data = chunk_bytes(lo, hi, first, end)
                 data_crc = zlib.crc32(data)
                 chunk_head = _CHUNK_HEAD.pack(
                     Opcode.CHUNK,
