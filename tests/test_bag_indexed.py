@@ -192,3 +192,49 @@ def test_a_bad_chunk_keeps_the_chunks_before_it(tmp_path: Path, damage: str) -> 
     assert kept == _contents(path, indexed=False, recover=True)
     count = sum(len(m[0]) for m in kept["messages"].values())
     assert 0 < count < 20000 and kept["truncated"] == [path]
+
+
+@pytest.mark.parametrize("layout", ["recorder", "zstd", "frames"])
+def test_decode_at_equals_decode_of_the_rows(tmp_path: Path, layout: str) -> None:
+    """Decoding the messages where they lie (`Bag.located`, `cdr.decode_at`) gives what
+    decoding their copied rows gives: one part or several (compressed chunks), all fields or
+    some, and None alike when the frame ids differ."""
+    from mcap.writer import CompressionType, Writer
+
+    from viscoadh_ros.io.ros_schemas import schema_text
+
+    path = tmp_path / f"{layout}.mcap"
+    if layout == "recorder":
+        record_stream(path, 1.0)
+    else:
+        with open(path, "wb") as stream:
+            writer = Writer(stream, chunk_size=1024, compression=CompressionType.ZSTD)
+            writer.start(profile="ros2")
+            schema = writer.register_schema(cdr.WRENCH, "ros2msg", schema_text(cdr.WRENCH).encode())
+            channel = writer.register_channel("/a/wrench", "cdr", schema)
+            for k in range(200):
+                frame = "f" * (1 + (k % 2 if layout == "frames" else 0))
+                (payload,) = cdr.encode(cdr.WRENCH, [k * 1001], frame, {"wrench.force.z": k * 0.5})
+                writer.add_message(channel, log_time=k, publish_time=k, data=payload, sequence=k)
+            writer.finish()
+    bag = Bag(path)
+    for topic, type_name in bag.topics.items():
+        log_ns, order, parts, length = bag.located(topic)
+        rows = bag.rows(topic)
+        np.testing.assert_array_equal(log_ns, rows[0])
+        np.testing.assert_array_equal(order, rows[1])
+        assert length is not None and rows[2] is not None
+        if layout == "frames":  # "f" and "ff": one payload length (padding), two frame ids
+            assert cdr.decode(type_name, rows[2]) is None
+            assert cdr.decode_at(type_name, parts, length) is None
+            continue
+        if layout == "zstd":
+            assert len(parts) > 3, "several compressed chunks"
+        for fields in (None, [cdr._FIELDS[type_name][1][-1][0]]):
+            expected = cdr.decode(type_name, rows[2], fields)
+            got = cdr.decode_at(type_name, parts, length, fields)
+            assert expected is not None and got is not None
+            assert set(got) == set(expected)
+            for name in expected:
+                np.testing.assert_array_equal(got[name], expected[name], err_msg=name)
+                assert got[name].dtype == expected[name].dtype, name

@@ -198,6 +198,58 @@ def decode(
     return columns
 
 
+def decode_at(
+    type_name: str,
+    parts: Sequence[tuple[NDArray[np.uint8], NDArray[np.int64]]],
+    length: int,
+    fields: Sequence[str] | None = None,
+) -> dict[str, NDArray] | None:
+    """:func:`decode` of messages that lie in buffers: ``parts`` are ``(buffer, starts)``, the
+    k-th message of a part being ``buffer[starts[k] : starts[k] + length]`` (see
+    ``Bag.located``). Each field is gathered straight from the buffers (a view of them at every
+    byte offset as the message layout), so the payloads are never copied out whole. Same
+    columns, the same None cases, as :func:`decode` of those payloads."""
+    if type_name not in _FIELDS or not parts or not any(starts.size for _, starts in parts):
+        return None
+    stamped = _FIELDS[type_name][0]
+    if length < (_HEADER + 12 if stamped else _HEADER):
+        return None
+    encapsulation = int(np.frombuffer(_ENCAPSULATION, "<u4")[0])
+    frame = None
+    for buffer, starts in parts:
+        if starts.size == 0:
+            continue
+        if np.any(starts < 0) or np.any(starts > buffer.size - length):
+            raise ValueError("a message runs past its buffer")
+        head = np.ndarray((buffer.size - 3,), "<u4", buffer, 0, (1,))
+        if np.any(head[starts] != encapsulation):
+            return None  # big endian or XCDR2: rclpy reads those
+        if stamped:
+            lengths = head[starts + _HEADER + 8]
+            frame = int(lengths[0]) - 1 if frame is None else frame
+            if frame < 0 or np.any(lengths != frame + 1):
+                return None
+    layout = _layout(type_name, frame or 0)
+    if layout.itemsize != length:
+        return None
+    known = [name for name, _ in _FIELDS[type_name][1]]
+    if fields is not None:
+        unknown = [name for name in fields if name not in known]
+        if unknown:
+            raise KeyError(f"{type_name} has no field {unknown[0]!r}")
+    names = list(known if fields is None else fields) + (["stamp.sec", "stamp.nanosec"] if stamped else [])
+    gathered: dict[str, list[NDArray]] = {name: [] for name in names}
+    for buffer, starts in parts:
+        records = np.ndarray((buffer.size - length + 1,), layout, buffer, 0, (1,))
+        for name in names:
+            gathered[name].append(records[name][starts])
+    columns = {name: np.concatenate(values) for name, values in gathered.items()}
+    if stamped:
+        sec, nanosec = columns.pop("stamp.sec"), columns.pop("stamp.nanosec")
+        columns["stamp_ns"] = sec.astype(np.int64) * 1_000_000_000 + nanosec
+    return columns
+
+
 def encode(
     type_name: str, stamp_ns: ArrayLike, frame_id: str, fields: Mapping[str, ArrayLike]
 ) -> list[bytes]:
