@@ -148,8 +148,8 @@ def _read_topic(bag: Bag, topic: str) -> tuple[NDArray[np.int64], NDArray[np.int
     :data:`_VALUE_FIELDS` of its type as arrays. Fixed-layout CDR is read in bulk; anything
     else message by message through rclpy."""
     type_name = bag.topics[topic]
-    log_ns, order, parts, length = bag.located(topic)
-    columns = None if length is None else cdr.decode_at(type_name, parts, length, _VALUE_FIELDS[type_name])
+    log_ns, order, rows = bag.rows(topic)
+    columns = None if rows is None else cdr.decode(type_name, rows, _VALUE_FIELDS[type_name])
     if columns is None:
         messages = list(bag.messages([topic]))
         log_ns = np.array([m.log_time_ns for m in messages], dtype=np.int64)

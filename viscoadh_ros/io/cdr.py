@@ -198,67 +198,6 @@ def decode(
     return columns
 
 
-#: Messages gathered at a time by :func:`decode_at` (a block of whole payloads small enough to
-#: stay in the cache while its fields are copied out).
-_BLOCK = 4096
-
-
-def decode_at(
-    type_name: str,
-    parts: Sequence[tuple[NDArray[np.uint8], NDArray[np.int64]]],
-    length: int,
-    fields: Sequence[str] | None = None,
-) -> dict[str, NDArray] | None:
-    """:func:`decode` of messages that lie in buffers: ``parts`` are ``(buffer, starts)``, the
-    k-th message of a part being ``buffer[starts[k] : starts[k] + length]`` (see
-    ``Bag.located``). The payloads are gathered a block at a time into one reused array (one
-    pass over the buffers, no copy of them all) and their fields copied out; same columns, the
-    same None cases, as :func:`decode` of those payloads."""
-    if type_name not in _FIELDS or not any(starts.size for _, starts in parts):
-        return None
-    stamped = _FIELDS[type_name][0]
-    if length < (_HEADER + 12 if stamped else _HEADER):
-        return None
-    first_buffer, first_starts = next((b, s) for b, s in parts if s.size)
-    head = first_buffer[int(first_starts[0]) : int(first_starts[0]) + length]
-    frame = int(head[_HEADER + 8 : _HEADER + 12].view("<u4")[0]) - 1 if stamped else 0
-    if frame < 0:
-        return None
-    layout = _layout(type_name, frame)
-    if layout.itemsize != length:
-        return None
-    known = [name for name, _ in _FIELDS[type_name][1]]
-    if fields is not None:
-        unknown = [name for name in fields if name not in known]
-        if unknown:
-            raise KeyError(f"{type_name} has no field {unknown[0]!r}")
-    names = list(known if fields is None else fields) + (["stamp.sec", "stamp.nanosec"] if stamped else [])
-    count = sum(starts.size for _, starts in parts)
-    columns = {name: np.empty(count, layout.fields[name][0]) for name in names}
-    block = np.empty(min(count, _BLOCK), layout)
-    encapsulation = np.frombuffer(_ENCAPSULATION, "V4")[0]
-    done = 0
-    for buffer, starts in parts:
-        if starts.size and (starts.min() < 0 or starts.max() > buffer.size - length):
-            raise ValueError("a message runs past its buffer")
-        items = np.ndarray((buffer.size - length + 1,), f"V{length}", buffer, 0, (1,))
-        for lo in range(0, starts.size, _BLOCK):
-            at = starts[lo : lo + _BLOCK]
-            rows = block[: at.size]
-            rows.view(f"V{length}")[:] = items[at]
-            if np.any(rows["encapsulation"] != encapsulation):
-                return None  # big endian or XCDR2: rclpy reads those
-            if stamped and np.any(rows["frame_id.length"] != frame + 1):
-                return None
-            for name in names:
-                columns[name][done : done + at.size] = rows[name]
-            done += at.size
-    if stamped:
-        sec, nanosec = columns.pop("stamp.sec"), columns.pop("stamp.nanosec")
-        columns["stamp_ns"] = sec.astype(np.int64) * 1_000_000_000 + nanosec
-    return columns
-
-
 def encode(
     type_name: str, stamp_ns: ArrayLike, frame_id: str, fields: Mapping[str, ArrayLike]
 ) -> list[bytes]:

@@ -4,22 +4,18 @@
 package's ``Writer`` (about 30 us per message in Python, more than replay's whole budget);
 :func:`write_columns` writes the same file from whole topics at once: the message records of
 a topic (fixed size when its payloads are, as :func:`viscoadh_ros.io.cdr.encode_array` makes
-them, or given as columns, :class:`viscoadh_ros.io.cdr.Messages`, serialised in place) are
-numpy structured arrays put in log-time order and cut into chunks; topics on the same log
-times (a state and its wrench per input) are built chunk by chunk into one reused block, so
-the file is never held whole. The message indexes are numpy arrays too. Only the handful of
-other records (header, schemas, channels, metadata, one ChunkIndex per chunk, the summary)
-go through ``mcap``'s record classes.
+them) are one numpy structured array, scattered in log-time order into one buffer that is cut
+into chunks; the message indexes are numpy arrays too. Only the handful of other records
+(header, schemas, channels, metadata, one Chunk/ChunkIndex per chunk, the summary) go through
+``mcap``'s record classes.
 
 The file follows what :class:`~viscoadh_ros.io.mcap_log.McapRecorder` writes (profile
 ``ros2``, ``ros2msg`` schemas, ``cdr`` channels with ``offered_qos_profiles``, the
-``viscoadh`` metadata record, uncompressed chunks with their CRC, a summary with statistics,
-chunk and metadata indexes), so ``mcap``'s reader, ``rosbags`` and
-:class:`~viscoadh_ros.io.bag.Bag` read it; schemas and channels sit in the data section before
-the first chunk and are repeated in the summary. Unlike the recorder's, its data-end record
-carries no data-section CRC (0, "not computed", as ``mcap``'s own ``Writer`` writes by
-default). Message order: by log time; at equal times the k-th messages of the topics before
-the (k+1)-th, topics in the given order (as ``write_mcap``).
+``viscoadh`` metadata record, uncompressed chunks, a summary with statistics, chunk and
+metadata indexes), so ``mcap``'s reader, ``rosbags`` and :class:`~viscoadh_ros.io.bag.Bag`
+read it; schemas and channels sit in the data section before the first chunk and are repeated
+in the summary. Message order: by log time; at equal times the k-th messages of the topics
+before the (k+1)-th, topics in the given order (as ``write_mcap``).
 """
 
 from __future__ import annotations
@@ -299,7 +295,7 @@ def write_columns(
     try:
         with open(path, "wb") as out:
             out.write(head)
-            position = len(head)
+            position, crc = len(head), zlib.crc32(head)
             for c, (lo, hi) in enumerate(zip(firsts.tolist(), lasts.tolist(), strict=True)):
                 first, end = int(starts[lo]), int(starts[hi - 1] + sizes[hi - 1])
                 data = chunk_bytes(lo, hi, first, end)
@@ -324,6 +320,7 @@ def write_columns(
                     indexes += body
                 for piece in (chunk_head, data, indexes):
                     out.write(piece)
+                    crc = zlib.crc32(piece, crc)
                 position = index_start + len(indexes)
                 chunk_indexes.append(
                     ChunkIndex(
@@ -338,9 +335,7 @@ def write_columns(
                         uncompressed_size=len(data),
                     )
                 )
-            # No data-section CRC (0: not computed, what mcap's own Writer writes by default):
-            # it would take a second pass over every chunk, whose records carry their own CRC.
-            DataEnd(data_section_crc=0).write(builder)
+            DataEnd(data_section_crc=crc).write(builder)
             tail = builder.end()
             position += len(tail)
             sections = (
