@@ -4,10 +4,12 @@
 package's ``Writer`` (about 30 us per message in Python, more than replay's whole budget);
 :func:`write_columns` writes the same file from whole topics at once: the message records of
 a topic (fixed size when its payloads are, as :func:`viscoadh_ros.io.cdr.encode_array` makes
-them) are one numpy structured array, scattered in log-time order into one buffer that is cut
-into chunks; the message indexes are numpy arrays too. Only the handful of other records
-(header, schemas, channels, metadata, one Chunk/ChunkIndex per chunk, the summary) go through
-``mcap``'s record classes.
+them, or given as columns, :class:`viscoadh_ros.io.cdr.Messages`, serialised in place) are
+numpy structured arrays put in log-time order and cut into chunks; topics on the same log
+times (a state and its wrench per input) are built chunk by chunk into one reused block, so
+the file is never held whole. The message indexes are numpy arrays too. Only the handful of
+other records (header, schemas, channels, metadata, one ChunkIndex per chunk, the summary)
+go through ``mcap``'s record classes.
 
 The file follows what :class:`~viscoadh_ros.io.mcap_log.McapRecorder` writes (profile
 ``ros2``, ``ros2msg`` schemas, ``cdr`` channels with ``offered_qos_profiles``, the
