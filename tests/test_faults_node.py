@@ -36,7 +36,7 @@ from viscoadh_msgs.msg import ContactEvent, ContactState, IndentationCommand
 from viscoadh_ros.core.config import SceneConfig
 from viscoadh_ros.core.simulator import ContactSimulator
 from viscoadh_ros.io.bag import Bag
-from viscoadh_ros.ros.conversions import ns_to_stamp
+from viscoadh_ros.ros.conversions import ns_to_stamp, stamp_to_ns
 
 VISCOADH = Path(sys.executable).parent / "viscoadh"
 START_TIMEOUT = 60.0  # child start-up (numba cache load) on a loaded 2-core machine, s
@@ -323,6 +323,16 @@ def test_stops_under_load_exit_cleanly(
             assert controller.connected(process), (tmp / "node.err").read_text()
             t0 = controller.now_ns()
             for k in range(300):
+                controller.pubs["soft"].publish(_command(t0 + k * 1_000_000, depth=4e-6))
+                controller.executor.spin_once(timeout_sec=0.001)
+            # Stop under load, not before it: on a loaded machine the node may not have taken a
+            # command yet (a 0.2.0 full run failed here with no command in the log). Wait for a
+            # state answering one of the stream's commands, then keep streaming into the stop.
+            answered = controller.spin_until(
+                lambda start=t0: any(stamp_to_ns(s.header.stamp) >= start for s in controller.states["soft"])
+            )
+            assert answered, f"run {run}: no command answered\n" + (tmp / "node.err").read_text()
+            for k in range(300, 400):
                 controller.pubs["soft"].publish(_command(t0 + k * 1_000_000, depth=4e-6))
                 controller.executor.spin_once(timeout_sec=0.001)
             rc = _stop(process, sig)

@@ -190,6 +190,17 @@ def test_rotated_files_keep_to_max_bytes_with_the_default_chunk(tmp_path: Path) 
     assert sum(Bag(p).message_count("/finger/state") for p in rec.paths) == 6000
 
 
+def test_message_count_of_a_topic_not_in_the_file_names_the_recorded_topics(tmp_path: Path) -> None:
+    """A misspelt or unrecorded topic is an InputError listing the recorded topics (it was a
+    bare KeyError), not a silent 0."""
+    with McapRecorder(tmp_path / "one.mcap") as rec:
+        assert rec.record_cdr("/finger/state", "std_msgs/msg/Float64", bytes(12), 1_000_000_000)
+    bag = Bag(rec.paths[0])
+    assert bag.message_count("/finger/state") == 1
+    with pytest.raises(InputError, match=r"'/finger/stat'.*/finger/state"):
+        bag.message_count("/finger/stat")
+
+
 def test_bad_settings_name_the_parameter(tmp_path: Path) -> None:
     for kwargs, name in [
         ({"chunk_size": 0}, "log.chunk_size"),

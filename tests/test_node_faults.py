@@ -24,6 +24,7 @@ from test_node_live import SCENE, TIMEOUT, Client, _command
 from viscoadh_msgs.msg import ContactEvent, ContactState, IndentationCommand
 
 from viscoadh_ros.core.config import SceneConfig
+from viscoadh_ros.core.errors import InputError
 from viscoadh_ros.core.simulator import ContactSimulator
 from viscoadh_ros.io.bag import Bag
 from viscoadh_ros.ros.node import ViscoadhNode
@@ -327,3 +328,65 @@ def test_diagnostics_warn_when_a_press_leaves_the_models_validity(
     status = statuses[-1]
     assert latest()["small_slope_ok"] == "False" and status.level == DiagnosticStatus.WARN, status.message
     assert "flank slope" in status.message and "small slopes" in status.message, status.message
+
+
+def test_a_hold_that_fails_keeps_the_state_and_the_timer_and_the_next_command_is_served(
+    ros_context: Any, ros_executor: Any, spin_until: Any
+) -> None:
+    """Issue 11's untested path: the hold timer's step fails (a held force that creep makes
+    unreachable; injected here, since no scene reaches it on cue). The contact keeps its state,
+    the timer keeps publishing it, and the next command is served from the kept state."""
+    node = _node(ros_context, ros_executor, {**FAULT_SCENE, "publish_rate": 100.0})
+    client = EventClient(ros_context, ros_executor, spin_until, contact="visco", ahead_ns=0)
+    now = client.node.get_clock().now().nanoseconds
+    pressed = client.send(_command(now, depth=5e-6))
+    assert pressed is not None
+    held = client.send(_command(now + 1_000_000, mode=IndentationCommand.FORCE, force=pressed.force))
+    assert held is not None
+    contact = node.contacts["visco"]
+    real_step = contact.simulator.step
+    failed: list[float] = []
+
+    def hold_fails(time: float, **control: float) -> Any:
+        if "force" in control:  # the held force: out of reach from now on
+            failed.append(time)
+            raise InputError(f"injected: force {control['force']!r} N cannot be reached")
+        return real_step(time, **control)
+
+    with contact.lock:
+        contact.simulator.step = hold_fails  # the instance's step: the hold timer's calls fail
+        kept = contact.simulator.snapshot()
+
+    def sim_time(state: ContactState) -> float:
+        return (state.header.stamp.sec * 10**9 + state.header.stamp.nanosec - contact.epoch_ns) * 1e-9
+
+    try:
+        assert spin_until(client.executor, lambda: len(failed) >= 3, TIMEOUT), "the timer stopped"
+        assert spin_until(
+            client.executor,
+            lambda: sum(sim_time(s) >= failed[0] for s in client.states) >= 2,
+            TIMEOUT,
+        ), "no state published while the hold fails"
+        published = [s for s in client.states if sim_time(s) >= failed[0]]
+        assert all(
+            (s.depth, s.force, s.contact_radius)
+            == (kept.output.depth, kept.output.force, kept.output.contact_radius)
+            for s in published
+        ), "the state changed while the hold failed"
+        assert contact.simulator.snapshot().time == kept.time
+        assert all(e.kind != 1 for e in client.events), "a failed hold is not a rejected command"
+        # The next command is served from the kept state, exactly as a twin restored to it.
+        twin = _twin("visco")
+        twin.restore(kept)
+        later = client.node.get_clock().now().nanoseconds
+        answer = client.send(_command(later, depth=4e-6))
+        assert answer is not None
+        expected = twin.step((later - contact.epoch_ns) * 1e-9, depth=4e-6)
+        assert (answer.depth, answer.force, answer.contact_radius) == (
+            expected.depth,
+            expected.force,
+            expected.contact_radius,
+        )
+    finally:
+        with contact.lock:
+            del contact.simulator.step

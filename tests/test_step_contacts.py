@@ -60,3 +60,49 @@ def test_bad_shapes_and_modes_are_refused_before_any_step() -> None:
     with pytest.raises(InputError, match="mode must be DEPTH"):
         step_contacts(sims, [0.0, 0.0], 5, [1e-5, 1e-5])
     assert all(s.time == 0.0 and not s.in_contact for s in sims)
+
+
+def _full_state(sim: ContactSimulator) -> tuple:
+    state = sim.snapshot().model_state
+    memory = b"" if state[2] is None else state[2].tobytes() + state[3].tobytes()
+    return (
+        sim.time,
+        sim.output,
+        sim._energy_input,
+        sim._held_force,
+        sim._force_memo,
+        state[0],
+        state[1],
+        state[4],
+        memory,
+    )
+
+
+@pytest.mark.parametrize("mode", [DEPTH, FORCE])
+def test_undone_contacts_go_on_exactly_as_if_the_sample_never_came(mode: int) -> None:
+    """The contacts stepped before a failing one are undone from their step's journal (no
+    snapshot): their whole state is back bit for bit, and they go on like contacts that never
+    saw the sample, also when the undone step grew the domain or searched a force."""
+    sims, alone = _simulators(3), _simulators(3)
+    for t, depth in ((0.0, 1e-5), (1e-3, 3e-5), (2e-3, 4e-5)):
+        step_contacts(sims, [t] * 3, DEPTH, [depth, depth / 2, depth / 3])
+        for s, d in zip(alone, [depth, depth / 2, depth / 3], strict=True):
+            s.step(t, depth=d)
+    before = [_full_state(s) for s in sims]
+    values = [9e-5, 2e-5, 3e-5] if mode == DEPTH else [5e-2, 1e-3, 0.0]
+    with pytest.raises(ContactStepError) as raised:
+        step_contacts(sims, [3e-3, 3e-3, 1e-3], mode, values)
+    assert raised.value.index == 2
+    assert [_full_state(s) for s in sims] == before
+    for t, value in ((4e-3, 2e-5), (5e-3, -1e-5), (6e-3, 5e-5)):
+        assert step_contacts(sims, [t] * 3, DEPTH, [value] * 3) == [s.step(t, depth=value) for s in alone]
+    for t, value in ((7e-3, 1e-3), (8e-3, 2e-3), (9e-3, 1e-3)):
+        assert step_contacts(sims, [t] * 3, FORCE, [value] * 3) == [s.step(t, force=value) for s in alone]
+    assert [_full_state(s)[8] for s in sims] == [_full_state(s)[8] for s in alone]
+
+
+def test_a_simulator_listed_twice_is_refused() -> None:
+    sims = _simulators(2)
+    with pytest.raises(InputError, match="each simulator once"):
+        step_contacts([sims[0], sims[1], sims[0]], [0.0] * 3, DEPTH, [1e-5] * 3)
+    assert all(s.time == 0.0 and not s.in_contact for s in sims)

@@ -47,25 +47,29 @@ def step_contacts(
             f"step_contacts needs one time and one value per simulator (got {count} simulators, "
             f"{len(times)} times, {len(values)} values)"
         )
-    if mode == DEPTH:
-        key = "depth"
-    elif mode == FORCE:
-        key = "force"
-    else:
+    if mode not in (DEPTH, FORCE):
         raise InputError(f"mode must be DEPTH ({DEPTH}) or FORCE ({FORCE}) (got {mode})")
-    snapshots = [simulator.snapshot() for simulator in simulators]
+    if len({id(simulator) for simulator in simulators}) != count:
+        raise InputError("step_contacts needs each simulator once (a simulator is listed twice)")
+    # Each simulator's transaction token, not a snapshot: a contact that stepped is undone from
+    # the journal its step wrote (no copies of the memory on the way through).
+    tokens = [simulator._undo_token() for simulator in simulators]
     outputs: list[StepOutput] = []
     index = 0
     try:
-        for index in range(count):
-            outputs.append(simulators[index].step(times[index], **{key: values[index]}))
+        if mode == DEPTH:
+            for index in range(count):
+                outputs.append(simulators[index].step(times[index], depth=values[index]))
+        else:
+            for index in range(count):
+                outputs.append(simulators[index].step(times[index], force=values[index]))
     except ValueError as error:
         # The failing simulator restored itself (step is a transaction); undo the ones before.
         for done in range(index):
-            simulators[done].restore(snapshots[done])
+            simulators[done]._undo(tokens[done])
         raise ContactStepError(index, str(error)) from None
     except BaseException:
         for done in range(index):
-            simulators[done].restore(snapshots[done])
+            simulators[done]._undo(tokens[done])
         raise
     return outputs

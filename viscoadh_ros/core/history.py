@@ -93,9 +93,7 @@ def simulate_history(
     if times.size == 0:
         raise InputError("time must have at least one sample")
     if control.size != times.size:
-        raise InputError(
-            f"{control_name} has {_samples(control.size)} but time has {_samples(times.size)}"
-        )
+        raise InputError(f"{control_name} has {_samples(control.size)} but time has {_samples(times.size)}")
     steps = np.flatnonzero(np.diff(times) <= 0.0)
     if steps.size:
         i = int(steps[0]) + 1

@@ -91,13 +91,51 @@ class StepOutput:
 STEP_OUTPUT_FIELDS = tuple(f.name for f in fields(StepOutput))
 
 
-def _new_output(*values: Any) -> StepOutput:
-    """A StepOutput from its field values in order, without the frozen dataclass's
-    ``__init__`` (one ``object.__setattr__`` per field, the larger part of a step's Python
-    cost): the instance is the same (same fields, equality, hash, repr)."""
-    output = object.__new__(StepOutput)
-    output.__dict__.update(zip(STEP_OUTPUT_FIELDS, values, strict=True))
+_object_new = object.__new__
+
+
+def _new_output(
+    time: float,
+    depth: float,
+    force: float,
+    contact_radius: float,
+    phase: Phase,
+    edge_speed: float,
+    effective_work_of_adhesion: float,
+    energy_input: float,
+    energy_dissipated: float,
+    scale_separation_ok: bool,
+    unstable: bool,
+) -> StepOutput:
+    """A StepOutput from its field values, without the frozen dataclass's ``__init__`` (one
+    ``object.__setattr__`` per field, the larger part of a step's Python cost): the instance
+    is the same (same fields, equality, hash, repr). A dict display fills the instance dict
+    (about half the time of zipping the names with the values)."""
+    output = _object_new(StepOutput)
+    output.__dict__.update(
+        {
+            "time": time,
+            "depth": depth,
+            "force": force,
+            "contact_radius": contact_radius,
+            "phase": phase,
+            "edge_speed": edge_speed,
+            "effective_work_of_adhesion": effective_work_of_adhesion,
+            "energy_input": energy_input,
+            "energy_dissipated": energy_dissipated,
+            "scale_separation_ok": scale_separation_ok,
+            "unstable": unstable,
+        }
+    )
     return output
+
+
+# The phases as module constants: an enum member lookup (`Phase.INDENTING`) costs several
+# times a global's.
+_NO_CONTACT = Phase.NO_CONTACT
+_INDENTING = Phase.INDENTING
+_STICKING = Phase.STICKING
+_DETACHING = Phase.DETACHING
 
 
 #: Largest flank slope f'(a) at the contact edge for which the half-space (small-slope) theory
@@ -347,6 +385,9 @@ class _TimeStepped:
     def __init__(self, physics: _Physics, numerics: ResolvedNumerics) -> None:
         self.physics = physics
         self.numerics = numerics
+        # Read every kernel call (the numerics are frozen).
+        self._max_substep = numerics.max_substep
+        self._max_edge_cells = numerics.max_edge_cells
         creep = physics.creep
         e_kelvin = np.array([creep.modulus_star(g) for g in creep.kelvin_shear_moduli], dtype=np.float64)
         # Dampers scale like springs: eta* = 2 eta / (1 - nu).
@@ -465,33 +506,38 @@ class _TimeStepped:
 
     # -- model interface ----------------------------------------------------------------
     def advance(self, d0: float, d1: float, dt: float) -> tuple[float, float, float]:
-        if not self._ensure_row(max(d0, d1)):
-            self.substeps = 0
-            return 0.0, 0.0, 0.0
-        assert self.row is not None
         row = self.row
-        if self._journal is not row:
-            # First kernel call of the transaction on this row: journal its memory (compiled
-            # copy into preallocated buffers) instead of a snapshot of numpy copies.
-            _kernels._copy_state(row.wl, row.wb, row.txn, row.txn_b)
-            self._journal = row
-            start = None
-        else:
-            start = self.get_state()
+        if row is None:
+            if not self._ensure_row(max(d0, d1)):
+                self.substeps = 0
+                return 0.0, 0.0, 0.0
+            row = self.row
+            assert row is not None
+        # The first kernel call of the transaction on this row journals its memory into the
+        # row's `txn` buffers (inside the compiled call, before the kernel writes anything)
+        # instead of a snapshot of numpy copies. `_journal` is set just before that call: no
+        # Python code runs between the two, and once it returned the journal is valid.
+        journal = self._journal is not row
+        start = None if journal else self.get_state()
         radius0, dissipated0 = self.radius, self.dissipated
         while True:
             row = self.row
+            if journal:
+                self._journal = row
             # The kernel itself, not the validating wrapper: the row's arrays are checked
             # when built, the step's scalars by ContactSimulator.step.
-            status = _kernels._advance(
-                *row.kernel_args,
+            status = _kernels._advance_packed(
+                row._state,
+                row._const,
+                journal,
                 self.radius,
                 d0,
                 d1,
                 dt,
-                self.numerics.max_substep,
-                self.numerics.max_edge_cells * row.dx,
+                self._max_substep,
+                self._max_edge_cells * row.dx,
             )
+            journal = False
             if status == _kernels.STATUS_OK:
                 break
             if start is None:
@@ -771,6 +817,7 @@ class Snapshot:
     output: StepOutput
     energy_input: float
     held_force: float | None
+    force_memo: Any = None
 
 
 class ContactSimulator:
@@ -791,6 +838,8 @@ class ContactSimulator:
             self._model: _ClosedForm | _TimeStepped = _ClosedForm(self.physics)
         else:
             self._model = _TimeStepped(self.physics, self.numerics)
+        # Depth steps may take the lean path in `step` (the time-stepped model only).
+        self._lean = isinstance(self._model, _TimeStepped)
         self.reset(0.0)
 
     # -- public state ---------------------------------------------------------------------
@@ -848,6 +897,10 @@ class ContactSimulator:
         self._depth = 0.0
         self._energy_input = 0.0
         self._held_force: float | None = None
+        # What the next force step predicts its root from (`_remember`): (the output it
+        # belongs to, slope dF/dd N/m, drift dF/dt at a held depth N/s, the slope's change
+        # along the path N/m^2), or None.
+        self._force_memo: tuple[StepOutput, float, float, float] | None = None
         self._model.reset()
         self._output = StepOutput(
             self._time, 0.0, 0.0, 0.0, Phase.NO_CONTACT, 0.0, 0.0, 0.0, 0.0, True, False
@@ -861,6 +914,7 @@ class ContactSimulator:
             self._output,
             self._energy_input,
             self._held_force,
+            self._force_memo,
         )
 
     def restore(self, snapshot: Snapshot) -> None:
@@ -870,6 +924,7 @@ class ContactSimulator:
         self._output = snapshot.output
         self._energy_input = snapshot.energy_input
         self._held_force = snapshot.held_force
+        self._force_memo = snapshot.force_memo
 
     # -- stepping -------------------------------------------------------------------------
     def _check_time(self, time: float) -> float:
@@ -885,20 +940,128 @@ class ContactSimulator:
         """Advance to `time` (s) under displacement control (`depth`, m) or force control
         (`force`, N); exactly one of them. Returns the new StepOutput. On any error the
         state is left as it was before the call."""
-        saved = (
+        # The lean path, for the common case: a finite float depth at a finite float time not
+        # before the last, on the time-stepped model, not idle above the surface (the general
+        # path drops that memory). It is `_step` / `_move` / `_publish` / `_make_output` in
+        # this one frame, the edge outputs read from the kernel's (`edge_height` and
+        # `edge_gaps` return the same values after an advance): the general path's outputs and
+        # state bit for bit, and its transaction (tests/test_step_lean.py).
+        if force is None and self._lean and isinstance(depth, float) and isinstance(time, float):
+            t = time if type(time) is float else float(time)
+            d = depth if type(depth) is float else float(depth)
+            model = self._model
+            d_prev = self._depth
+            output0 = self._output
+            r0 = output0.contact_radius
+            time0 = self._time
+            if (
+                t - t == 0.0
+                and d - d == 0.0
+                and t >= time0
+                and not (d < 0.0 and d_prev < 0.0 and r0 <= 0.0 and model.is_relaxed())
+            ):
+                energy0 = self._energy_input
+                held0 = self._held_force
+                token = model.begin()
+                try:
+                    dt = t - time0
+                    radius, f, work = model.advance(d_prev, d, dt)
+                    energy = energy0 + work
+                    physics = self.physics
+                    if radius <= 0.0:
+                        phase = _NO_CONTACT
+                        g_edge = 0.0
+                    else:
+                        outside, inside, g_edge = model._edge
+                        if radius > r0:
+                            phase = _INDENTING
+                        elif radius < r0:
+                            phase = _DETACHING
+                        else:
+                            tol = 1e-9 * (abs(d) + physics.c_crit * math.sqrt(radius) + g_edge)
+                            if outside >= -tol:
+                                phase = _INDENTING
+                            elif inside <= tol:
+                                phase = _DETACHING
+                            else:
+                                phase = _STICKING
+                    edge_speed = (radius - r0) / dt if dt > 0.0 else 0.0
+                    u = d - g_edge
+                    if radius > 0.0 and u < 0.0:
+                        effective = physics.e_relaxed * u * u / (2.0 * math.pi * radius)
+                    else:
+                        effective = 0.0
+                    if edge_speed == 0.0:
+                        separated = True
+                    else:
+                        v_c1, v_c2 = physics.critical_speeds
+                        separated = abs(edge_speed) >= (v_c1 if edge_speed > 0.0 else v_c2)
+                    # `_new_output` inline (a call with 11 arguments is ~0.1 us of this path).
+                    output = _object_new(StepOutput)
+                    output.__dict__.update(
+                        {
+                            "time": t,
+                            "depth": d,
+                            "force": f,
+                            "contact_radius": radius,
+                            "phase": phase,
+                            "edge_speed": edge_speed,
+                            "effective_work_of_adhesion": effective,
+                            "energy_input": energy,
+                            "energy_dissipated": model.dissipated,
+                            "scale_separation_ok": separated,
+                            "unstable": False,
+                        }
+                    )
+                    self._energy_input = energy
+                    self._time = t
+                    self._depth = d
+                    self._output = output
+                    self._held_force = None
+                    return output
+                except BaseException:
+                    model.rollback(token)
+                    self._energy_input, self._time, self._depth = energy0, time0, d_prev
+                    self._output, self._held_force = output0, held0
+                    raise
+        return self._step_transaction(time, depth, force)
+
+    def _step_transaction(self, time: float, depth: float | None, force: float | None) -> StepOutput:
+        """`step` on the general path: validation, then `_step` as a transaction."""
+        saved = self._undo_token()
+        try:
+            return self._step(time, depth, force)
+        except BaseException:
+            self._undo(saved)
+            raise
+
+    def _undo_token(self) -> tuple:
+        """Begin a transaction: the token `_undo` takes to bring back the state of now, either
+        from inside the next step (its rollback) or after it succeeded (`core.hand` undoes the
+        contacts of a sample that stepped before a failing one). No copies: the memory comes
+        back from the journal the step's first kernel call writes (`_TimeStepped.begin`). Valid
+        until the simulator's next step or restore."""
+        return (
             self._model.begin(),
             self._time,
             self._depth,
             self._output,
             self._energy_input,
             self._held_force,
+            self._force_memo,
         )
-        try:
-            return self._step(time, depth, force)
-        except BaseException:
-            self._model.rollback(saved[0])
-            self._time, self._depth, self._output, self._energy_input, self._held_force = saved[1:]
-            raise
+
+    def _undo(self, token: tuple) -> None:
+        """Back to the state `_undo_token` saw (see there)."""
+        self._model.rollback(token[0])
+        (
+            self._time,
+            self._depth,
+            self._output,
+            self._energy_input,
+            self._held_force,
+            self._force_memo,
+        ) = token[1:]
 
     def _step(self, time: float, depth: float | None, force: float | None) -> StepOutput:
         t = self._check_time(time)
@@ -1037,22 +1200,22 @@ class ContactSimulator:
         physics = self.physics
         g_edge = self._model.edge_height(radius) if radius > 0.0 else 0.0
         if radius <= 0.0:
-            phase = Phase.NO_CONTACT
+            phase = _NO_CONTACT
         elif radius > r0:
-            phase = Phase.INDENTING
+            phase = _INDENTING
         elif radius < r0:
-            phase = Phase.DETACHING
+            phase = _DETACHING
         else:
             # Pinned edge: say which criterion it rests on, if any (elastic contacts at
-            # rest sit on both; a punch rim blocks attachment).
+            # rest sit on both; a punch rim blocks attachment). `step`'s lean path repeats this.
             tol = 1e-9 * (abs(depth) + physics.c_crit * math.sqrt(radius) + g_edge)
             outside, inside = self._model.edge_gaps(depth)
             if outside >= -tol:
-                phase = Phase.INDENTING
+                phase = _INDENTING
             elif inside <= tol:
-                phase = Phase.DETACHING
+                phase = _DETACHING
             else:
-                phase = Phase.STICKING
+                phase = _STICKING
         edge_speed = (radius - r0) / dt if dt > 0.0 else 0.0
         dissipated = self._model.energy_dissipated(self._energy_input, depth)
         u = depth - g_edge
@@ -1090,35 +1253,69 @@ class ContactSimulator:
             )
         return 2.0 * self.physics.e_relaxed * radius
 
-    def _solve_force(self, time: float, target: float) -> StepOutput:
-        """Find the depth whose step from the current state gives `target` force (N)."""
-        start = self.snapshot()
-        d0 = self._depth
-        tol = self.numerics.force_tolerance * max(abs(target), abs(self._output.force), 1e-300)
-        # The root search stops within half the tolerance relative to the commanded force,
-        # floored at 1e-6 of the contact's adhesive force scale 2 E0* a dl_c(a) (the JKR
-        # adhesive term at the current radius): a zero force commanded to a contact in
-        # adhesive equilibrium is not chased down to 1e-300 N (44 trials per step).
-        radius = self._output.contact_radius
+    def _force_stop(self, target: float, radius: float) -> float:
+        """Where the root search stops, N: within half the force tolerance relative to the
+        commanded force, floored at 1e-6 of the contact's adhesive force scale 2 E0* a dl_c(a)
+        (the JKR adhesive term at the contact radius `radius`, m): a zero force commanded to a
+        contact in adhesive equilibrium is not chased down to 1e-300 N (44 trials per step)."""
         adhesive = 2.0 * self.physics.e0 * radius * self.physics.c_crit * math.sqrt(radius)
-        stop = 0.5 * self.numerics.force_tolerance * max(abs(target), 1e-6 * adhesive, 1e-300)
+        return 0.5 * self.numerics.force_tolerance * max(abs(target), 1e-6 * adhesive, 1e-300)
+
+    def _solve_force(self, time: float, target: float) -> StepOutput:
+        """Find the depth whose step from the current state gives `target` force (N).
+
+        Every trial is a full step of the model from the current state (rewound before each).
+        When the last step was a converged force step in contact, a secant predicted from it
+        (`_predicted_root`: its slope dF/dd and the force's drift at a held depth) usually
+        lands within the tolerance in one or two trials and is published as it stands; when
+        its checks fail (a trial detached, or a slope unlike the last one: near the fold of
+        the force-depth curve), the bracketing search from the held depth runs instead."""
+        # The model's state before the step (the simulator's own fields change only when the
+        # result is published): every trial but the first rewinds the model to it.
+        model = self._model
+        start = model.get_state()
+        d0 = self._depth
+        before = self._output
+        f0 = before.force
+        dt = time - self._time
+        tol = self.numerics.force_tolerance * max(abs(target), abs(f0), 1e-300)
+        stop = self._force_stop(target, self._output.contact_radius)
         was_in_contact = self.in_contact
 
-        model = self._model
         last: list[Any] = [None, None]  # depth of the last trial and its (radius, force, work)
+        trials: list[tuple[float, float, float]] = []  # (depth, force, radius) of every trial
 
         def residual(depth: float) -> float:
-            model.rewind(start.model_state)
+            if last[0] is not None:
+                model.rewind(start)
             result = self._trial(time, depth)
             last[0], last[1] = depth, result
+            trials.append((depth, result[1], result[0]))
             return result[1] - target
+
+        memo = self._force_memo
+        if memo is not None and memo[0] is self._output and was_in_contact:
+            slope, drift_rate, bend = memo[1], memo[2], memo[3]
+            # F(d) ~ F(d0) + slope (d - d0), F(d0) ~ f0 + drift_rate dt.
+            first = d0 + (target - f0 - drift_rate * dt) / slope
+            root = self._predicted_root(residual, d0, first, slope, bend, stop)
+            if root is not None:
+                # The model is in the state of the trial at the root: publish it as it stands.
+                output = self._publish(time, root, last[1], unstable=False)
+                self._remember(output, before, trials, d0, f0, dt, None, slope)
+                return output
+            trials.clear()
 
         r_hold = residual(d0)
         if abs(r_hold) <= tol:
-            return self._publish(time, d0, last[1], unstable=False)
+            output = self._publish(time, d0, last[1], unstable=False)
+            self._force_memo = None
+            return output
+        hold_force = r_hold + target
         direction = 1.0 if r_hold < 0.0 else -1.0
         if direction < 0.0 and not self._attached() and not was_in_contact:
             # Out of contact and pulled away: no equilibrium, the indenter stays off.
+            self._force_memo = None
             return self._publish(time, d0, last[1], unstable=target < 0.0)
         # First bracketing step: the Newton step on the contact's instantaneous (glass)
         # stiffness 2 E0* a, the stiffest the contact can answer, so the step falls short of
@@ -1128,41 +1325,200 @@ class ContactSimulator:
         stiffness = self._stiffness_guess()
         if self._output.contact_radius > 0.0:
             stiffness *= self.physics.e0 / self.physics.e_relaxed
+        elif model.radius > 0.0:
+            # Out of contact, but the held depth touched (snap-in, or the surface crept back):
+            # the glass stiffness of the contact that formed.
+            stiffness = 2.0 * self.physics.e0 * model.radius
         delta = max(abs(r_hold) / stiffness, 1e-12 * (abs(d0) + 1e-12))
         lo, r_lo = d0, r_hold
-        last_contact = d0
+        # Pulled to a zero force, an adhesive contact holds it before it lets go; a detached
+        # trial (zero force too) is no root then: look for the attached one.
+        adhesive = self.physics.work_of_adhesion > 0.0
         for _ in range(200):
             hi = lo + direction * delta
             r_hi = residual(hi)
-            if r_hi * direction >= 0.0:
+            detached = direction < 0.0 and not self._attached()
+            if r_hi * direction >= 0.0 and not (detached and r_hi == 0.0 and adhesive):
                 break
-            if direction < 0.0 and not self._attached():
-                found = self._search_dip(residual, hi, last_contact)
+            if detached:
+                found, boundary = self._search_dip(residual, trials, target, stop)
                 if found is None:
-                    return self._pulled_off(residual, hi, last_contact, time, start)
-                hi, r_hi = found
+                    return self._pulled_off(boundary, time, start, last)
+                lo, r_lo, hi, r_hi = found
                 break
-            last_contact = hi
             lo, r_lo = hi, r_hi
             delta *= 2.0
         else:
-            self.restore(start)
+            model.rewind(start)
             raise InputError(f"force {target!r} N cannot be reached from depth {d0!r} m")
+        if not was_in_contact and self._attached():
+            # Snapped in: the stop's floor from the contact that formed.
+            stop = max(stop, self._force_stop(target, model.radius))
         root, r_root = _bracketed_root(residual, lo, r_lo, hi, r_hi, stop)
         if last[0] != root:
             r_root = residual(root)
         jumped_in = not was_in_contact and self._attached() and self.physics.work_of_adhesion > 0.0
-        # A residual left at the root means the force jumped across the target (snap-in or
-        # a discontinuous edge): no continuous equilibrium path; keep the state reached.
-        unstable = abs(r_root) > max(tol, 1e-9 * abs(target)) or jumped_in
+        # A residual left at the root beyond where the search stops means the force jumped
+        # across the target (snap-in or a discontinuous edge): no continuous equilibrium
+        # path; keep the state reached.
+        unstable = abs(r_root) > max(tol, stop, 1e-9 * abs(target)) or jumped_in
         # The model is in the state of the trial at the root: publish it (no second trial).
-        return self._publish(time, root, last[1], unstable=unstable)
+        output = self._publish(time, root, last[1], unstable=unstable)
+        self._remember(output, before, trials, d0, f0, dt, hold_force, None)
+        return output
 
-    def _search_dip(self, residual, detached: float, attached: float) -> tuple[float, float] | None:
-        """Between an attached and a detached trial depth, look for a force below the target
-        that the bracketing step skipped (the minimum of F(d) lies before the fold)."""
-        lo, hi = detached, attached
+    #: Trials of the predicted secant before it gives way to the bracketing search.
+    PREDICTED_TRIALS = 4
+
+    def _predicted_root(
+        self, residual, d0: float, first: float, slope: float, bend: float, stop: float
+    ) -> float | None:
+        """Secant steps from the predicted depth `first` (m), the first with the last step's
+        slope `slope` (N/m) carried from the held depth `d0` to `first` by its change along
+        the path `bend` (N/m^2). Returns the depth of the trial within `stop` (N) of the
+        target (the model left in its state), or None when a trial detaches, a secant slope
+        is not within a factor 4 of `slope` (the force-depth curve bends: a fold or a jump is
+        near, which the bracketing search handles) or PREDICTED_TRIALS trials did not
+        converge."""
+        x = first
+        r = residual(x)
+        if not self._attached():
+            return None
+        tangent = slope + bend * (first - d0)
+        if not 0.5 * slope < tangent < 2.0 * slope:
+            tangent = slope
+        for _ in range(self.PREDICTED_TRIALS - 1):
+            if abs(r) <= stop:
+                return x
+            x_new = x - r / tangent
+            if x_new == x:
+                return None
+            r_new = residual(x_new)
+            if not self._attached():
+                return None
+            secant = (r_new - r) / (x_new - x)
+            if not 0.25 * slope <= secant <= 4.0 * slope:
+                return None
+            x, r, tangent = x_new, r_new, secant
+        return x if abs(r) <= stop else None
+
+    def _remember(
+        self,
+        output: StepOutput,
+        before: StepOutput,
+        trials: list[tuple[float, float, float]],
+        d0: float,
+        f0: float,
+        dt: float,
+        hold_force: float | None,
+        slope: float | None,
+    ) -> None:
+        """Keep what the next force step predicts its root from: the slope dF/dd at the root
+        (from the trial nearest it, else `slope`), its change along the path since the step
+        that ended in `before` (the output before this step), and the rate at which the force
+        drifts at a held depth (from `hold_force`, the trial at the held depth d0, else
+        extrapolated along the slope), tied to `output` (stale once the simulator's output
+        is another)."""
+        previous = self._force_memo
+        if previous is not None and previous[0] is not before:
+            previous = None
+        self._force_memo = None
+        root = output.depth
+        if output.unstable or output.contact_radius <= 0.0:
+            return
+        nearest = None
+        for depth, force, radius in trials:
+            closer = nearest is None or abs(depth - root) < abs(nearest[0] - root)
+            if radius > 0.0 and depth != root and closer:
+                nearest = (depth, force)
+        if nearest is not None:
+            slope = (output.force - nearest[1]) / (root - nearest[0])
+        if slope is None or not 0.0 < slope < math.inf:
+            return
+        if hold_force is None:
+            hold_force = output.force + slope * (d0 - root)
+        drift_rate = (hold_force - f0) / dt if dt > 0.0 else 0.0
+        # The slope's change along the path, from the last step's slope if it left one.
+        bend = 0.0
+        if previous is not None and root != d0:
+            bend = (slope - previous[1]) / (root - d0)
+        if math.isfinite(drift_rate) and math.isfinite(bend):
+            self._force_memo = (output, slope, drift_rate, bend)
+
+    def _search_dip(
+        self,
+        residual,
+        trials: list[tuple[float, float, float]],
+        target: float,
+        stop: float,
+    ) -> tuple[tuple[float, float, float, float] | None, float]:
+        """A pull's bracketing steps reached a detached trial with every attached trial above
+        the target: look for an attached force at or below the target between them (the
+        minimum of F(d) lies before the fold, and the steps may have skipped it). Returns
+        ((lo, r_lo, hi, r_hi): a bracket of the root nearest the held depth, or None) and,
+        when there is none, the depth (detached side) where the contact lets go.
+
+        The minimum is searched by golden section between the neighbours (by depth) of the
+        smallest attached trial, a detached point counting as above everything, and given up
+        once the smallest attached force found is above the target by more than the force can
+        drop within the bracket; only then is the detachment depth bisected, to 1e-13
+        relative or to where the force cannot move by more than `stop` (N) across the
+        interval. Both use the Lipschitz bound 2 x the glass stiffness 2 E0* a of the largest
+        contact tried (F(d) moves no faster under an instantaneous change of depth)."""
+        radius = max((r for _, _, r in trials), default=0.0)
+        lipschitz = 4.0 * self.physics.e0 * radius
+        samples = sorted(trials)
+        attached = [i for i, (_, _, r) in enumerate(samples) if r > 0.0]
+        if attached:
+            j = min(attached, key=lambda i: samples[i][1])
+            a = samples[max(j - 1, 0)][0]
+            b = samples[min(j + 1, len(samples) - 1)][0]
+            golden = 0.5 * (math.sqrt(5.0) - 1.0)
+
+            def value(x: float) -> float:
+                """The residual at x, +inf when detached (the minimum is attached)."""
+                r_x = residual(x)
+                return r_x if self._attached() else math.inf
+
+            c = b - golden * (b - a)
+            d = a + golden * (b - a)
+            rc = value(c)
+            if rc <= 0.0:
+                return self._dip_bracket(trials, target, c, rc), math.nan
+            rd = value(d)
+            if rd <= 0.0:
+                return self._dip_bracket(trials, target, d, rd), math.nan
+            # One new trial per iteration: the interior point that stays is reused.
+            for _ in range(120):
+                # c and d lie inside [a, b]: the smallest attached force in it is above the
+                # target unless it drops by more than the bound across the bracket.
+                inside = min(rc, rd)
+                if lipschitz * (b - a) < inside < math.inf:
+                    break
+                if abs(b - a) <= 1e-10 * max(abs(a), abs(b), 1e-300):
+                    break
+                if rc < rd:
+                    b, d, rd = d, c, rc
+                    c = b - golden * (b - a)
+                    rc = value(c)
+                    if rc <= 0.0:
+                        return self._dip_bracket(trials, target, c, rc), math.nan
+                else:
+                    a, c, rc = c, d, rd
+                    d = a + golden * (b - a)
+                    rd = value(d)
+                    if rd <= 0.0:
+                        return self._dip_bracket(trials, target, d, rd), math.nan
+        # No dip: bisect the detachment between the deepest detached trial shallower than
+        # every attached one and the shallowest attached trial.
+        hi = min((d for d, _, r in trials if r > 0.0), default=math.nan)
+        lo = max((d for d, _, r in trials if r <= 0.0 and d < hi), default=math.nan)
+        if not (math.isfinite(lo) and math.isfinite(hi)):
+            return None, min(d for d, _, r in trials if r <= 0.0)
+        width = stop / lipschitz if lipschitz > 0.0 else 0.0
         for _ in range(60):
+            if hi - lo <= max(1e-13 * max(abs(hi), abs(lo), 1e-300), width):
+                break
             mid = 0.5 * (lo + hi)
             r_mid = residual(mid)
             if not self._attached():
@@ -1170,52 +1526,27 @@ class ContactSimulator:
             else:
                 hi = mid
                 if r_mid <= 0.0:
-                    return mid, r_mid
-            if hi - lo <= 1e-13 * max(abs(hi), abs(lo), 1e-300):
-                break
-        # Golden-section on the attached interval for the force minimum.
-        a, b = hi, attached
-        golden = 0.5 * (math.sqrt(5.0) - 1.0)
-        c = b - golden * (b - a)
-        d = a + golden * (b - a)
-        rc = residual(c)
-        if rc <= 0.0:
-            return c, rc
-        rd = residual(d)
-        if rd <= 0.0:
-            return d, rd
-        # One new trial per iteration: the interior point that stays is reused.
-        for _ in range(120):
-            if rc < rd:
-                b, d, rd = d, c, rc
-                c = b - golden * (b - a)
-                rc = residual(c)
-                if rc <= 0.0:
-                    return c, rc
-            else:
-                a, c, rc = c, d, rd
-                d = a + golden * (b - a)
-                rd = residual(d)
-                if rd <= 0.0:
-                    return d, rd
-            if abs(b - a) <= 1e-10 * max(abs(a), abs(b), 1e-300):
-                break
-        return None
+                    return self._dip_bracket(trials, target, mid, r_mid), math.nan
+        return None, lo
 
-    def _pulled_off(
-        self, residual, detached: float, attached: float, time: float, start: Snapshot
-    ) -> StepOutput:
+    @staticmethod
+    def _dip_bracket(
+        trials: list[tuple[float, float, float]], target: float, dip: float, r_dip: float
+    ) -> tuple[float, float, float, float]:
+        """The bracket (lo, r_lo, dip, r_dip) of the root between the attached trial `dip`
+        (force at or below the target) and the nearest trial on the held depth's side
+        (larger depth: the search pulls) whose force is above the target (the held depth's
+        trial is one)."""
+        lo, r_lo = min((d, f - target) for d, f, _ in trials if d > dip and f - target > 0.0)
+        return lo, r_lo, dip, r_dip
+
+    def _pulled_off(self, detached: float, time: float, start: Any, last: list[Any]) -> StepOutput:
         """No equilibrium under force control: move to the detached state at the depth where
-        the contact let go, flagged unstable."""
-        lo, hi = detached, attached
-        for _ in range(60):
-            mid = 0.5 * (lo + hi)
-            residual(mid)
-            if self._attached():
-                hi = mid
-            else:
-                lo = mid
-            if hi - lo <= 1e-13 * max(abs(hi), abs(lo), 1e-300):
-                break
-        self.restore(start)
-        return self._move(time, lo, unstable=True)
+        the contact let go (`detached`, m, from `_search_dip`), flagged unstable; `start`:
+        the model's state before the step; `last`: the depth of the last trial and its
+        result (when that trial was at `detached`, the model is in that state already)."""
+        self._force_memo = None
+        if last[0] == detached:
+            return self._publish(time, detached, last[1], unstable=True)
+        self._model.rewind(start)
+        return self._move(time, detached, unstable=True)

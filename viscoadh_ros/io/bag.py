@@ -398,8 +398,15 @@ class Bag:
         return {name: t.type_name for name, t in self._topics.items()}
 
     def message_count(self, topic: str) -> int:
-        """Number of messages recorded on ``topic``."""
-        return self._topics[topic].count
+        """Number of messages recorded on ``topic`` (its exact recorded name). A topic with no
+        message in the file raises InputError naming the recorded topics (a misspelt name
+        must not read as an empty topic)."""
+        info = self._topics.get(topic)
+        if info is None:
+            raise InputError(
+                f"topic {topic!r} has no message in {str(self.path)!r} (topics: {sorted(self._topics)})"
+            )
+        return info.count
 
     def _cdr(self, topic: str) -> _Topic:
         info = self._topics[topic]

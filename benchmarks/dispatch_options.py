@@ -1,0 +1,137 @@
+"""Cost of calling a numba kernel from Python by the way its arguments are passed (issue 13).
+
+    .venv/bin/python benchmarks/dispatch_options.py
+
+Every option calls a compiled function that does (almost) nothing, so the figure is the
+dispatch alone: numba's type check and unboxing of each argument, and for the packed options
+the making of the kernel's array views inside the call. Interleaved, median of repeats, ns per
+call; the row is the default-like scene's (N = 160, K = 1).
+"""
+
+from __future__ import annotations
+
+import numba
+import numpy as np
+
+from viscoadh_ros.bench.timing import interleaved_medians
+from viscoadh_ros.core import _kernels
+from viscoadh_ros.core.config import SceneConfig, default_scene_path
+from viscoadh_ros.core.simulator import ContactSimulator
+
+CALLS = 2000
+
+
+@numba.njit(nogil=True)
+def _args31(wl, wsum, wb, bsum, scratch, scratch_b, diss, dx, g_c, gf, gint, gmin, gmax, df, e0, c_crit,
+            reach, p, p_inv, lam, beta, rate, kap, e_kelvin, out, a, d0, d1, dt, ms, me):  # fmt: skip
+    out[0] = a + wl.shape[0]
+    return 0
+
+
+@numba.njit(nogil=True)
+def _tuple(args, a, d0, d1, dt, ms, me):
+    args[-1][0] = a + args[0].shape[0]
+    return 0
+
+
+@numba.njit(nogil=True)
+def _arrays_and_scalar_array(wl, wsum, wb, bsum, scratch, scratch_b, diss, g_c, gf, gint, gmin, gmax, p,
+                             p_inv, lam, beta, rate, e_kelvin, out, scalars):  # fmt: skip
+    out[0] = scalars[0]
+    return 0
+
+
+@numba.njit(nogil=True)
+def _two_buffers_scalar_array(state, const, scalars):
+    state[0] = scalars[0] + const[0]
+    return 0
+
+
+@numba.njit(nogil=True)
+def _two_buffers(state, const, journal, a, d0, d1, dt, ms, me):
+    state[0] = a + const[0]
+    return 0
+
+
+@numba.njit(nogil=True)
+def _two_buffers_sliced_views(state, const, journal, a, d0, d1, dt, ms, me):
+    # The same views as `_kernels._unpack`, made by slicing and reshaping the buffers.
+    n, k, m, blocks = int(const[0]), int(const[1]), int(const[2]), int(const[3])
+    nk = n * k
+    views = []
+    o = 0
+    for size in (nk, n, nk, n, nk, nk, n, _kernels.OUT_SIZE, nk, nk):
+        views.append(state[o : o + size])
+        o += size
+    q = _kernels.PACK_HEADER
+    for size in (n, m, m, blocks, blocks, k * k, k * k, k, k, k, k):
+        views.append(const[q : q + size])
+        q += size
+    wl = views[0].reshape((n, k))
+    wb = views[2].reshape((n, k))
+    return wl.shape[0] + wb.shape[0] + len(views)
+
+
+@numba.njit(nogil=True)
+def _two_buffers_unpacked(state, const, journal, a, d0, d1, dt, ms, me):
+    args, txn, txn_b = _kernels._unpack(state, const)
+    return args[0].shape[0] + txn.shape[0]
+
+
+def main() -> None:
+    sim = ContactSimulator(SceneConfig.from_yaml(default_scene_path()).contacts[0])
+    for i in range(1, 60):
+        sim.step(i * 1e-3, depth=i * 1e-6)
+    row = sim._model.row
+    args = row.kernel_args
+    arrays = tuple(a for a in args if isinstance(a, np.ndarray))
+    scalars = np.zeros(12)
+    state, const = row._state, row._const
+
+    def loop(call):
+        def run() -> None:
+            for _ in range(CALLS):
+                call()
+
+        return run
+
+    options = {
+        "31 arguments (19 arrays, 12 floats): _advance's signature": loop(
+            lambda: _args31(*args, 1.0, 2.0, 3.0, 1e-3, 0.0, 1e-6)
+        ),
+        "the row's 25 arguments as one tuple + 6 floats": loop(
+            lambda: _tuple(args, 1.0, 2.0, 3.0, 1e-3, 0.0, 1e-6)
+        ),
+        "19 arrays + the scalars packed in one array": loop(
+            lambda: _arrays_and_scalar_array(*arrays, scalars)
+        ),
+        "2 buffers + the scalars packed in one array (3 writes)": loop(
+            lambda: (
+                scalars.__setitem__(0, 1.0),
+                scalars.__setitem__(1, 2.0),
+                scalars.__setitem__(2, 3.0),
+                _two_buffers_scalar_array(state, const, scalars),
+            )
+        ),
+        "2 buffers + bool + 6 floats": loop(
+            lambda: _two_buffers(state, const, True, 1.0, 2.0, 3.0, 1e-3, 0.0, 1e-6)
+        ),
+        "2 buffers + bool + 6 floats, views by slicing": loop(
+            lambda: _two_buffers_sliced_views(state, const, True, 1.0, 2.0, 3.0, 1e-3, 0.0, 1e-6)
+        ),
+        "2 buffers + bool + 6 floats, views by _unpack (carray)": loop(
+            lambda: _two_buffers_unpacked(state, const, True, 1.0, 2.0, 3.0, 1e-3, 0.0, 1e-6)
+        ),
+        "empty Python loop (lambda call)": loop(lambda: None),
+    }
+    for run in options.values():
+        run()
+    medians = interleaved_medians(options, repeats=40)
+    print("| how the arguments are passed | ns per call |")
+    print("|---|---|")
+    for name, seconds in medians.items():
+        print(f"| {name} | {seconds / CALLS * 1e9:.0f} |")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,164 @@
+"""The depth-control step path gives bit-equal outputs to the 0.2.0 path (golden from main).
+
+`step_scenarios` records varied sequences (snap-in, pull-off, out of contact with memory,
+depth jumps at one time, domain growth, refused calls mid-way, reset, snapshot/restore into the
+same and another simulator, `advance`, `step_depths`); the golden was written from main at
+fecbb5f before the lean step path and the packed kernel call.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+import pickle
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scenes import one_contact
+from step_scenarios import depth_scale, run_scene, scenes
+
+from viscoadh_ros.core import _kernels, simulator
+from viscoadh_ros.core.simulator import ContactSimulator
+
+GOLDEN = Path(__file__).resolve().parent / "data" / "step_golden.npz"
+
+
+@pytest.mark.parametrize("name", sorted(scenes()))
+def test_step_path_is_bit_equal_to_the_golden(name: str) -> None:
+    expected = np.load(GOLDEN)[name]
+    got = run_scene(scenes()[name], depth_scale(name))
+    assert got.shape == expected.shape
+    bad = np.flatnonzero(np.any(got.view(np.uint64) != expected.view(np.uint64), axis=1))
+    assert bad.size == 0, f"{name}: first differing row {bad[0]}: {got[bad[0]]} != {expected[bad[0]]}"
+
+
+def _state(sim) -> tuple:
+    """Everything a step may change, bytes for the memory."""
+    model = sim._model
+    row = model.row
+    memory = (
+        b"" if row is None else row.wl.tobytes() + row.wb.tobytes() + row.wsum.tobytes() + row.bsum.tobytes()
+    )
+    return (
+        sim.time,
+        sim._depth,
+        sim.output,
+        sim._energy_input,
+        sim._held_force,
+        sim._force_memo,
+        model.radius,
+        model.dissipated,
+        model._memory_peak,
+        model._edge,
+        model._edge_depth,
+        row,
+        memory,
+    )
+
+
+def _sequence(seed: int, scale: float) -> list[tuple[str, float, float]]:
+    rng = np.random.default_rng(seed)
+    calls, t = [], 0.0
+    for _ in range(260):
+        kind = rng.choice(["depth"] * 12 + ["same_time", "force", "advance", "nan", "back"])
+        t += 0.0 if kind == "same_time" else float(rng.choice([1e-3, 1e-4, 5e-3]))
+        calls.append((str(kind), t, scale * float(rng.uniform(-0.6, 1.6))))
+    return calls
+
+
+@pytest.mark.parametrize("name", ["default", "two_kelvin", "growing", "punch"])
+@pytest.mark.parametrize("seed", [1, 2])
+def test_the_lean_path_equals_the_general_path(name: str, seed: int) -> None:
+    """`step` (lean path for float depths) and `_step_transaction` (the general path) give
+    bit-equal outputs and states over random sequences with force steps, holds, jumps at one
+    time and refused calls between the depth steps."""
+    contact, scale = scenes()[name], depth_scale(name)
+    lean, general = ContactSimulator(contact), ContactSimulator(contact)
+    for kind, t, value in _sequence(seed, scale):
+        results = []
+        for sim, depth_step in (
+            (lean, lambda s, t, d: s.step(t, depth=d)),
+            (general, lambda s, t, d: s._step_transaction(t, d, None)),
+        ):
+            try:
+                if kind in ("depth", "same_time"):
+                    results.append(depth_step(sim, t, value))
+                elif kind == "force":
+                    results.append(sim.step(t, force=value * 1e2))
+                elif kind == "advance":
+                    results.append(sim.advance(t))
+                elif kind == "nan":
+                    results.append(depth_step(sim, t, math.nan))
+                else:
+                    results.append(depth_step(sim, t - 1.0, value))
+            except ValueError as error:
+                results.append(type(error).__name__ + str(error))
+        assert results[0] == results[1], (kind, t, value)
+        assert _state(lean)[:11] == _state(general)[:11]
+        assert _state(lean)[12] == _state(general)[12]
+
+
+class _Interrupt(BaseException):
+    pass
+
+
+def test_an_interrupt_inside_the_lean_step_changes_nothing(monkeypatch: pytest.MonkeyPatch) -> None:
+    contact, scale = scenes()["standard_fast"], depth_scale("standard_fast")
+    sim, reference = ContactSimulator(contact), ContactSimulator(contact)
+    for k in range(1, 40):
+        sim.step(k * 1e-3, depth=scale * 0.03 * k)
+        reference.step(k * 1e-3, depth=scale * 0.03 * k)
+    assert sim._model.row is not None and sim.in_contact
+    before = _state(sim)
+    real = simulator._object_new
+
+    def interrupted(*args):
+        raise _Interrupt
+
+    # After the kernel ran (the output record is the step's last work before it commits).
+    monkeypatch.setattr(simulator, "_object_new", interrupted)
+    with pytest.raises(_Interrupt):
+        sim.step(40e-3, depth=scale * 1.3)
+    assert _state(sim) == before
+    monkeypatch.setattr(simulator, "_object_new", real)
+    for k in range(40, 60):
+        assert sim.step(k * 1e-3, depth=scale * 0.02 * (80 - k)) == reference.step(
+            k * 1e-3, depth=scale * 0.02 * (80 - k)
+        )
+    assert _state(sim)[12] == _state(reference)[12]
+
+
+@pytest.mark.parametrize("kelvin", [0, 1, 3])
+def test_the_packed_views_are_the_rows_kernel_arguments(kelvin: int) -> None:
+    """`_kernels._unpack` (what `_advance_packed` hands `_advance`) finds every array of
+    `Row.kernel_args` at the same address with the same shape, and the same scalars; also
+    for a `with_memory` clone and after pickling and deep copying."""
+    contact = one_contact(
+        {"shape": "sphere", "radius": 0.005},
+        kelvin=[1e5 * (k + 1) for k in range(kelvin)],
+        viscosities=[1e3 * 10**k for k in range(kelvin)],
+        work=0.05,
+        numerics={"elements": 40, "model": "time_stepped"},
+    )
+    sim = ContactSimulator(contact)
+    for k in range(1, 20):
+        sim.step(k * 1e-3, depth=k * 1e-6)
+    row = sim._model.row
+    clone = row.with_memory(row.wl * 0.5, row.wb)
+    for candidate in (row, clone, pickle.loads(pickle.dumps(row)), copy.deepcopy(row)):
+        args, txn, txn_b = _kernels._unpack(candidate._state, candidate._const)
+        expected = candidate.kernel_args
+        assert len(args) == len(expected) == _kernels._advance.py_func.__code__.co_argcount - 6
+        for got, want in zip(args, expected, strict=True):
+            if isinstance(want, np.ndarray):
+                assert got.shape == want.shape
+                assert want.size == 0 or got.ctypes.data == want.ctypes.data  # (no data: any address)
+                assert np.array_equal(got, want)
+            else:
+                assert got == want
+        if txn.size:
+            assert txn.ctypes.data == candidate.txn.ctypes.data
+            assert txn_b.ctypes.data == candidate.txn_b.ctypes.data
+    assert np.array_equal(clone.wl, row.wl * 0.5) and not np.shares_memory(clone.wl, row.wl)
+    assert np.shares_memory(clone.gf, row.gf)
