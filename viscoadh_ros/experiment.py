@@ -149,7 +149,7 @@ def _read_topic(bag: Bag, topic: str) -> tuple[NDArray[np.int64], NDArray[np.int
     else message by message through rclpy."""
     type_name = bag.topics[topic]
     log_ns, order, rows = bag.rows(topic)
-    columns = None if rows is None else cdr.decode(type_name, rows)
+    columns = None if rows is None else cdr.decode(type_name, rows, _VALUE_FIELDS[type_name])
     if columns is None:
         messages = list(bag.messages([topic]))
         log_ns = np.array([m.log_time_ns for m in messages], dtype=np.int64)
@@ -396,9 +396,13 @@ def _node_verdicts(
     # Older stamps, per stretch between restarts: the last accepted stamp is the running
     # maximum of the candidates before (a candidate refused for its stamp is below it).
     segment = np.searchsorted(np.array([r.order for r in restarts], dtype=np.int64), order)
+    refused_so_far = np.zeros(order.size, dtype=np.bool_)
+    refused_so_far[list(reasons)] = True
+    received_segment = segment[received]
+    received_open = ~refused_so_far[received]
     for seg in np.unique(segment).tolist():
-        positions = received[np.isin(received, np.flatnonzero(segment == seg))]
-        candidates = np.array([p for p in positions.tolist() if p not in reasons], dtype=np.int64)
+        # This stretch's commands not refused yet, in the order received.
+        candidates = received[(received_segment == seg) & received_open]
         if candidates.size < 2:
             continue
         last = np.maximum.accumulate(stamps[candidates])
@@ -619,8 +623,16 @@ def _depth_stretch(
     model_force[index[measured]] = force[measured]
     inputs = index[is_input]
     input_rows = (np.cumsum(steps) - 1)[is_input]
-    for name, values in result.items():
-        columns[name][inputs] = values[input_rows]
+    count = inputs.size
+    if count and int(np.count_nonzero(steps)) == count and np.all(np.diff(inputs) == 1):
+        # Every step is an input's (no measured stamp advanced time on its own, the usual
+        # case) and the inputs are consecutive: whole columns, no gather and scatter per field.
+        at = slice(int(inputs[0]), int(inputs[0]) + count)
+        for name, values in result.items():
+            columns[name][at] = values
+    else:
+        for name, values in result.items():
+            columns[name][inputs] = values[input_rows]
 
 
 @dataclass(frozen=True)

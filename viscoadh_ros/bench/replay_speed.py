@@ -3,10 +3,14 @@
 The recording is made here with the project's own MCAP writer: the node's log format, one
 contact of the bench scene (default numerics), an `IndentationCommand` and a measured
 `WrenchStamped` per millisecond, the scene stored in the file. The whole `viscoadh replay` run
-is timed (realtime factor = recorded duration / wall time), and beside it its stages with the
-same public functions the verb uses: decode (open the bag, read the experiment), simulate
-(`run_model`), encode and compare (the rest of the verb: building and writing the output MCAP
-and the force comparison).
+is timed (realtime factor = recorded duration / wall time); inside each run the verb's own
+simulation time (`run_model`, read back from its ``--json`` summary) splits it into simulate
+and everything else (reading, decoding, the conversions between columns, comparing, encoding,
+writing, the Python around the simulator calls), per run, so the split does not depend on
+another run's noise. Beside it, interleaved: decode alone (open the bag, read the experiment)
+and `ContactSimulator.step_depths` alone over the same depth history from a fresh simulator
+(the compiled stepper with no replay around it: what simulate would cost if replay added
+nothing).
 """
 
 from __future__ import annotations
@@ -19,7 +23,7 @@ from pathlib import Path
 from typing import Any
 
 from viscoadh_ros.bench.latency import bench_scene
-from viscoadh_ros.bench.timing import interleaved_medians
+from viscoadh_ros.bench.timing import interleaved_samples
 from viscoadh_ros.core.config import SceneConfig
 
 RATE_HZ = 1000.0
@@ -61,48 +65,67 @@ def record_stream(path: Path, seconds: float) -> SceneConfig:
 
 
 def replay_benchmark(*, seconds: float, repeats: int) -> dict[str, Any]:
-    """The `replay` results section: realtime factor and the share of decode/simulate/encode."""
+    """The `replay` results section: realtime factor, the share of decode/simulate/encode, the
+    non-simulation cost per command and the bare `step_depths` beside the verb's simulate."""
+    import json
+
+    import numpy as np
+
     from viscoadh_ros.cli.main import main as cli_main
-    from viscoadh_ros.experiment import choose_contact, load_experiment, run_model
+    from viscoadh_ros.core.simulator import ContactSimulator
+    from viscoadh_ros.experiment import choose_contact, load_experiment
     from viscoadh_ros.io.bag import Bag
 
     with tempfile.TemporaryDirectory(prefix="viscoadh_bench_") as tmp:
         bag_path = Path(tmp) / "stream.mcap"
         scene = record_stream(bag_path, seconds)
-        out_path = Path(tmp) / "replayed.mcap"
+        out_path, summary_path = Path(tmp) / "replayed.mcap", Path(tmp) / "summary.json"
         experiment = load_experiment(Bag(bag_path))
         contact = choose_contact(scene, None)
+        duration = float(experiment.duration)
+        times = experiment.time(experiment.input_ns)
+        depths = experiment.input_value
+        inner: list[float] = []  # each whole run's own simulate time, s
 
         def whole() -> None:
+            for path in (out_path, summary_path):
+                path.unlink(missing_ok=True)
             with contextlib.redirect_stdout(io.StringIO()):
-                status = cli_main(["replay", str(bag_path), "-o", str(out_path)])
+                status = cli_main(["replay", str(bag_path), "-o", str(out_path), "--json", str(summary_path)])
             if status != 0:
                 raise RuntimeError(f"viscoadh replay exited with status {status}")
+            speed = json.loads(summary_path.read_text())["replay_speed_x_real_time"]
+            inner.append(duration / speed)
 
         whole()  # imports and compiled code loaded once, outside the timing
-        times = interleaved_medians(
+        inner.clear()
+        samples = interleaved_samples(
             {
                 "total": whole,
                 "decode": lambda: load_experiment(Bag(bag_path)),
-                "simulate": lambda: run_model(contact, experiment),
+                "step_depths": lambda: ContactSimulator(contact).step_depths(times, depths),
             },
             repeats=repeats,
         )
-    duration = float(experiment.duration)
-    # The stages are timed apart from the whole run, so noise can make them add up to a little
-    # more than it: shares are of their sum, with encode the non-negative remainder.
-    stages = {
-        "decode": times["decode"],
-        "simulate": times["simulate"],
-        "encode and compare": max(0.0, times["total"] - times["decode"] - times["simulate"]),
-    }
+    commands = int(experiment.input_ns.size)
+    total = float(np.median(samples["total"]))
+    simulate = float(np.median(inner))
+    rest = float(np.median(np.array(samples["total"]) - np.array(inner)))
+    decode = min(float(np.median(samples["decode"])), rest)
+    bare = float(np.median(samples["step_depths"]))
+    # Shares of the whole run: simulate measured inside it, decode timed apart (capped at the
+    # run's non-simulation time), encode and compare the remainder.
+    stages = {"decode": decode, "simulate": simulate, "encode and compare": max(0.0, rest - decode)}
     stage_sum = sum(stages.values())
     return {
-        "commands": int(experiment.input_ns.size),
+        "commands": commands,
         "recorded_s": duration,
-        "wall_s": times["total"],
-        "realtime_factor": duration / times["total"],
-        "simulate_realtime_factor": duration / times["simulate"],
-        "us_per_command": times["total"] / experiment.input_ns.size * 1e6,
-        "time_share": {stage: seconds / stage_sum for stage, seconds in stages.items()},
+        "wall_s": total,
+        "realtime_factor": duration / total,
+        "simulate_realtime_factor": duration / simulate,
+        "us_per_command": total / commands * 1e6,
+        "simulate_us_per_command": simulate / commands * 1e6,
+        "non_simulation_us_per_command": rest / commands * 1e6,
+        "step_depths_us_per_command": bare / commands * 1e6,
+        "time_share": {stage: value / stage_sum for stage, value in stages.items()},
     }

@@ -494,6 +494,15 @@ def render_markdown(results: dict[str, Any], figure: Path | None, notes: str | N
             f"{_mark(replay['realtime_factor'] >= REPLAY_FACTOR_TARGET)}.",
             "",
         ]
+        if "non_simulation_us_per_command" in replay:
+            lines += [
+                f"Per command: {_g(replay['us_per_command'])} us in all; simulate "
+                f"{_g(replay['simulate_us_per_command'])} us inside the verb (`step_depths` alone over "
+                f"the same depth history {_g(replay['step_depths_us_per_command'])} us); everything "
+                f"else (read, decode, compare, encode, write, the Python around the simulator) "
+                f"{_g(replay['non_simulation_us_per_command'])} us.",
+                "",
+            ]
         lines += _table(
             ["stage", "share of time"],
             [[stage, f"{share:.1%}"] for stage, share in replay["time_share"].items()],

@@ -30,6 +30,13 @@ def interleaved_medians(runs: dict[str, Callable[[], object]], *, repeats: int) 
     Interleaving puts a burst of load from elsewhere on the machine onto all runs alike, so
     their ratio stays meaningful on a shared machine where absolute times drift.
     """
+    samples = interleaved_samples(runs, repeats=repeats)
+    return {name: float(np.median(values)) for name, values in samples.items()}
+
+
+def interleaved_samples(runs: dict[str, Callable[[], object]], *, repeats: int) -> dict[str, list[float]]:
+    """Every wall time of each named run, s, the runs interleaved repeat by repeat (see
+    :func:`interleaved_medians`), for a caller that pairs them with what it measured inside."""
     if repeats < 1:
         raise ValueError(f"repeats must be >= 1, got {repeats}")
     samples: dict[str, list[float]] = {name: [] for name in runs}
@@ -38,7 +45,7 @@ def interleaved_medians(runs: dict[str, Callable[[], object]], *, repeats: int) 
             start = time.perf_counter()
             run()
             samples[name].append(time.perf_counter() - start)
-    return {name: float(np.median(values)) for name, values in samples.items()}
+    return samples
 
 
 def latency_summary(latencies_s: Sequence[float], *, prefix: str) -> dict[str, float]:

@@ -279,7 +279,8 @@ def _write_output(
     """The model's states and wrenches on the input stamps, with the scene, as MCAP.
 
     The messages are those of ``ros.conversions.contact_state`` / ``wrench``, serialised in
-    bulk (io/cdr.py): one message object per output cost more than the simulation.
+    bulk (io/cdr.py) straight into the file's records (``cdr.Messages``): one message object
+    per output cost more than the simulation.
     """
 
     import numpy as np
@@ -289,18 +290,21 @@ def _write_output(
     from viscoadh_ros.io.mcap_log import TopicData
     from viscoadh_ros.ros.conversions import MODEL_CODES, STATE_OUTPUT_FIELDS
 
-    fields = list(STATE_OUTPUT_FIELDS)
-    rows = np.column_stack([run.input_columns[name] for name in fields]).astype(np.float64)
-    columns = dict(zip(fields, rows.T, strict=True))
+    columns = {name: run.input_columns[name] for name in STATE_OUTPUT_FIELDS}
     received, rejected = experiment.counters
-    models = run.input_model if run.input_model is not None else np.full(rows.shape[0], run.model)
-    state = {
-        **columns,
-        "model": np.array([MODEL_CODES[name] for name in models.tolist()], dtype=np.uint8),
-        "commands_received": received,
-        "commands_rejected": rejected,
-    }
-    frame, stamps = scene.node.frame_id, experiment.input_ns
+    stamps = experiment.input_ns
+    if run.input_model is None:
+        model: np.ndarray | int = MODEL_CODES[run.model]
+    else:
+        model = np.zeros(stamps.size, dtype=np.uint8)
+        known = np.zeros(stamps.size, dtype=np.bool_)
+        for name, code in MODEL_CODES.items():
+            mine = run.input_model == name
+            model[mine], known[mine] = code, True
+        if not known.all():
+            raise KeyError(str(run.input_model[np.flatnonzero(~known)[0]]))
+    state = {**columns, "model": model, "commands_received": received, "commands_rejected": rejected}
+    frame = scene.node.frame_id
     if path.exists():
         path.unlink()
     write_columns(
@@ -310,13 +314,13 @@ def _write_output(
                 f"/{contact_id}/state",
                 cdr.CONTACT_STATE,
                 stamps,
-                cdr.encode_array(cdr.CONTACT_STATE, stamps, frame, state),
+                cdr.Messages(cdr.CONTACT_STATE, stamps, frame, state),
             ),
             TopicData(
                 f"/{contact_id}/wrench",
                 cdr.WRENCH,
                 stamps,
-                cdr.encode_array(cdr.WRENCH, stamps, frame, {"wrench.force.z": columns["force"]}),
+                cdr.Messages(cdr.WRENCH, stamps, frame, {"wrench.force.z": columns["force"]}),
             ),
         ],
         scene=scene.to_dict(),

@@ -3,11 +3,14 @@
 Messages are deserialised with :func:`rclpy.serialization.deserialize_message` into the
 installed message classes, or read in bulk as raw CDR (:meth:`Bag.raw`, :meth:`Bag.rows`) for
 the fixed-layout decoders of :mod:`viscoadh_ros.io.cdr`. The file is walked here, record by
-record with one ``struct`` call each (message indexes and the summary are skipped: the
-``mcap`` package's reader parses every index entry as an object, which cost more than the
-messages); a chunk's message records are located the same way and then read as columns
-(channel, log time, payload offset and size as numpy arrays; payloads of one length as one
-(n, L) array). A file that was not finished (a recorder killed mid-run) has no footer: it is
+record with one ``struct`` call each (the summary is skipped: the ``mcap`` package's reader
+parses every index entry as an object, which cost more than the messages). A chunk's message
+records are located from the message index records that follow it, read as numpy arrays and
+accepted only when they tile the chunk exactly (every record a message, each starting where
+the one before ends); otherwise (no or partial indexes, a channel or schema record inside the
+chunk, a damaged index) the chunk is walked record by record. The messages are then read as
+columns (channel, log time, payload offset and size as numpy arrays; payloads of one length
+as one (n, L) array). A file that was not finished (a recorder killed mid-run) has no footer: it is
 read up to the last complete chunk; :class:`Bag` refuses it with a clear :class:`InputError`
 unless ``recover=True``.
 """
@@ -84,6 +87,10 @@ class _Topic:
         ]
 
 
+#: libyaml's safe loader when PyYAML was built with it (the same documents, ~10x faster than
+#: the pure-Python one on a scene), else the pure-Python one.
+_SAFE_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+
 _RECORD_TYPES = {Opcode.SCHEMA: Schema, Opcode.CHANNEL: Channel, Opcode.METADATA: Metadata}
 
 #: Record header (opcode u8, length u64) and Message record fields before the payload
@@ -123,6 +130,59 @@ def _bag_files(path: Path) -> list[Path]:
     return files
 
 
+def _unaligned(buffer: NDArray[np.uint8], dtype: str) -> NDArray:
+    """``buffer`` read as ``dtype`` numbers starting at every byte (a view, no copy): element k
+    is the number whose first byte is ``buffer[k]``."""
+    itemsize = np.dtype(dtype).itemsize
+    return np.ndarray((max(buffer.size - itemsize + 1, 0),), dtype, buffer, 0, (1,))
+
+
+def _message_indexes(data: bytes, position: int) -> list[tuple[int, int]]:
+    """The (start, end) of the bodies of the complete message index records from
+    ``position`` on (those that follow a chunk)."""
+    found = []
+    length = len(data)
+    while position + _RECORD_HEADER.size <= length:
+        opcode, size = _RECORD_HEADER.unpack_from(data, position)
+        start = position + _RECORD_HEADER.size
+        if opcode != Opcode.MESSAGE_INDEX or start + size > length:
+            break
+        found.append((start, start + size))
+        position = start + size
+    return found
+
+
+def _indexed_starts(
+    data: bytes, buffer: NDArray[np.uint8], indexes: list[tuple[int, int]]
+) -> NDArray[np.int64] | None:
+    """The offsets of a chunk's message records (``buffer``: its records) from its message
+    indexes (bodies at ``indexes`` in ``data``), in record order; None unless those records
+    tile the chunk exactly: the first at 0, each next one where the one before ends, the last
+    ending at the chunk's end, every one a message record (then the walk finds the same)."""
+    offsets = []
+    for start, end in indexes:
+        if end - start < 6:
+            return None
+        (entries,) = struct.unpack_from("<I", data, start + 2)
+        if entries % 16 or 6 + entries != end - start:
+            return None
+        offsets.append(np.frombuffer(data, "<u8", entries // 8, start + 6)[1::2])
+    if not offsets:
+        return None
+    found = np.concatenate(offsets)
+    if found.size == 0 or np.any(found > buffer.size):
+        return None
+    starts = np.sort(found.astype(np.int64), kind="stable")  # runs per channel: merged fast
+    if starts[0] != 0 or starts[-1] + _RECORD_HEADER.size + _MESSAGE_FIELDS.size > buffer.size:
+        return None
+    if np.any(buffer[starts] != Opcode.MESSAGE):
+        return None
+    ends = starts + _RECORD_HEADER.size + _unaligned(buffer, "<u8")[starts + 1].astype(np.int64)
+    if ends[-1] != buffer.size or np.any(ends[:-1] != starts[1:]):
+        return None
+    return starts
+
+
 class Bag:
     """All messages of a recording, read once into memory (raw CDR, decoded on demand).
 
@@ -131,6 +191,10 @@ class Bag:
         recover: Accept unfinished (truncated) files, keeping the messages of every complete
             chunk. Otherwise such a file raises :class:`InputError`.
     """
+
+    #: Locate a chunk's messages from its message indexes when they tile it (else walk it);
+    #: False walks every chunk (the reference the tests compare the indexed reading with).
+    use_indexes = True
 
     def __init__(self, path: str | Path, *, recover: bool = False) -> None:
         self.path = Path(path)
@@ -148,6 +212,12 @@ class Bag:
         data = file.read_bytes()
         if not data.startswith(_MAGIC):
             raise InputError(f"{str(file)!r} is not an MCAP file")
+        # Message records of uncompressed chunks (and outside chunks) lie in ``data`` itself:
+        # their file offsets are gathered chunk by chunk and added as columns in one pass
+        # (`_flush`) before anything that could change what they mean (a channel or schema
+        # record) and at the end.
+        self._buffer = np.frombuffer(data, np.uint8)
+        self._pending: list[NDArray[np.int64]] = []
         finished = False
         try:
             position, length = len(_MAGIC), len(data)
@@ -160,11 +230,13 @@ class Bag:
                 if position > length:
                     raise McapError(f"a record of {size} bytes overruns the file")
                 if opcode == Opcode.CHUNK:
-                    self._read_chunk(data, start, position, channels, schemas)
+                    indexes = _message_indexes(data, position) if self.use_indexes else []
+                    self._read_chunk(data, start, position, indexes, channels, schemas)
                 elif opcode == Opcode.MESSAGE:
-                    buffer = np.frombuffer(data, np.uint8)
-                    self._add_messages(buffer, np.array([start - _RECORD_HEADER.size]), channels, schemas)
+                    self._pending.append(np.array([start - _RECORD_HEADER.size]))
                 elif opcode in _RECORD_TYPES:
+                    if opcode != Opcode.METADATA:
+                        self._flush(channels, schemas)
                     record = _RECORD_TYPES[opcode].read(ReadDataStream(BytesIO(data[start:position])))
                     if opcode == Opcode.SCHEMA:
                         schemas[record.id] = record
@@ -174,6 +246,7 @@ class Bag:
                         self.metadata.setdefault(record.name, {}).update(record.metadata)
                 elif opcode == Opcode.FOOTER:
                     finished = True
+            self._flush(channels, schemas)
             if not finished:
                 raise McapError("the file ends before its footer")
         except (McapError, struct.error, ValueError, EOFError) as exc:
@@ -182,13 +255,25 @@ class Bag:
                     f"{str(file)!r} is truncated or damaged ({type(exc).__name__}: {exc}); "
                     "pass --recover to use the messages up to its last complete chunk"
                 ) from None
+            try:  # the complete chunks before the damage
+                self._flush(channels, schemas)
+            except McapError:
+                pass
+        self._pending = []
         if not finished:
             self.truncated.append(file)
 
     def _read_chunk(
-        self, data: bytes, start: int, end: int, channels: dict[int, Channel], schemas: dict[int, Schema]
+        self,
+        data: bytes,
+        start: int,
+        end: int,
+        indexes: list[tuple[int, int]],
+        channels: dict[int, Channel],
+        schemas: dict[int, Schema],
     ) -> None:
-        """The records of one chunk (CRC-checked; decompressed by ``mcap`` if compressed)."""
+        """The records of one chunk (CRC-checked; decompressed by ``mcap`` if compressed);
+        ``indexes``: the (start, end) of the bodies of the message index records after it."""
         _, _, uncompressed, crc, name_length = _CHUNK_FIELDS.unpack_from(data, start)
         at = start + _CHUNK_FIELDS.size
         compression = data[at : at + name_length].decode()
@@ -197,27 +282,34 @@ class Bag:
         if body_start + size > end:
             raise McapError("chunk records overrun the chunk")
         if compression:
+            self._flush(channels, schemas)
             chunk = Chunk.read(ReadDataStream(BytesIO(data[start:end])))
             stream, length = get_chunk_data_stream(chunk, validate_crc=True)
-            records = stream.read(length)
+            records: bytes | memoryview = stream.read(length)
         else:
-            records = data[body_start : body_start + size]
+            records = memoryview(data)[body_start : body_start + size]
             if crc and zlib.crc32(records) != crc:
                 raise McapError("chunk CRC mismatch")
             if len(records) != uncompressed:
                 raise McapError("chunk size differs from its uncompressed size")
+        buffer = np.frombuffer(records, np.uint8)
+        starts = _indexed_starts(data, buffer, indexes) if indexes else None
+        if starts is not None:
+            self._messages(compression, body_start, buffer, starts, channels, schemas)
+            return
         length = len(records)
-        starts: list[int] = []  # of the message records
+        found: list[int] = []  # starts of the message records
         position = 0
         unpack = _RECORD_HEADER.unpack_from
         while position < length:
             opcode, size = unpack(records, position)
             if opcode == Opcode.MESSAGE:
-                starts.append(position)
+                found.append(position)
             elif opcode in (Opcode.CHANNEL, Opcode.SCHEMA):
-                if starts:  # the messages before it, on channels already known
-                    self._add_messages(np.frombuffer(records, np.uint8), np.array(starts), channels, schemas)
-                    starts = []
+                if found:  # the messages before it, on channels already known
+                    self._messages(compression, body_start, buffer, np.array(found), channels, schemas)
+                    found = []
+                self._flush(channels, schemas)
                 body = ReadDataStream(BytesIO(records[position + 9 : position + 9 + size]))
                 if opcode == Opcode.CHANNEL:
                     channel = Channel.read(body)
@@ -228,8 +320,36 @@ class Bag:
             position += _RECORD_HEADER.size + size
             if position > length:
                 raise McapError(f"chunk record of {size} bytes overruns its chunk")
-        if starts:
-            self._add_messages(np.frombuffer(records, np.uint8), np.array(starts), channels, schemas)
+        if found:
+            self._messages(compression, body_start, buffer, np.array(found), channels, schemas)
+
+    def _messages(
+        self,
+        compression: str,
+        body_start: int,
+        buffer: NDArray[np.uint8],
+        starts: NDArray[np.int64],
+        channels: dict[int, Channel],
+        schemas: dict[int, Schema],
+    ) -> None:
+        """Message records at ``starts`` of a chunk's records ``buffer``: added now from a
+        decompressed buffer, else kept as file offsets for `_flush`."""
+        if compression:
+            self._add_messages(buffer, starts, channels, schemas)
+        else:
+            self._pending.append(starts + body_start)
+
+    def _flush(self, channels: dict[int, Channel], schemas: dict[int, Schema]) -> None:
+        """Add the pending message records of the file in one pass; when that fails (a bad
+        record or channel), chunk by chunk, so those before the bad one are kept."""
+        batch, self._pending = self._pending, []
+        if not batch:
+            return
+        try:
+            self._add_messages(self._buffer, np.concatenate(batch), channels, schemas)
+        except McapError:
+            for starts in batch:
+                self._add_messages(self._buffer, starts, channels, schemas)
 
     def _add_messages(
         self,
@@ -239,19 +359,23 @@ class Bag:
         schemas: dict[int, Schema],
     ) -> None:
         """Message records at ``starts`` of ``buffer``, as columns per topic, in order."""
-        fields = buffer[starts[:, None] + np.arange(_RECORD_HEADER.size + _MESSAGE_FIELDS.size)]
-        # (n, 31): opcode, record length, channel id, sequence, log time, publish time.
-        record_size = fields[:, 1:9].copy().view("<u8")[:, 0].astype(np.int64)
-        channel_id = fields[:, 9:11].copy().view("<u2")[:, 0]
-        log_ns = fields[:, 15:23].copy().view("<u8")[:, 0].astype(np.int64)
+        # Every record lies whole in ``buffer`` (its caller checked its length), so the
+        # fields after the opcode are read as unaligned numbers at the records' offsets.
+        record_size = _unaligned(buffer, "<u8")[starts + 1].astype(np.int64)
         if np.any(record_size < _MESSAGE_FIELDS.size):
             raise McapError("a message record shorter than its fields")
+        channel_id = _unaligned(buffer, "<u2")[starts + 9]
+        ids = np.unique(channel_id).tolist()
+        unknown = [cid for cid in ids if cid not in channels]
+        if unknown:  # before anything is added
+            raise McapError(f"message on channel {unknown[0]}, which is not defined before it")
+        log_ns = _unaligned(buffer, "<u8")[starts + 15].astype(np.int64)
         order = self._records + np.arange(starts.size, dtype=np.int64)
         self._records += starts.size
         payload_start = starts + _RECORD_HEADER.size + _MESSAGE_FIELDS.size
         payload_size = record_size - _MESSAGE_FIELDS.size
-        for cid in np.unique(channel_id).tolist():
-            mine = channel_id == cid
+        for cid in ids:
+            mine = channel_id == cid if len(ids) > 1 else slice(None)
             self._topic(cid, channels, schemas).parts.append(
                 _Part(buffer, payload_start[mine], payload_size[mine], log_ns[mine], order[mine])
             )
@@ -303,8 +427,17 @@ class Bag:
         sizes = info.column("sizes")
         if sizes.size == 0 or np.any(sizes != sizes[0]):
             return info.column("log_ns"), info.column("order"), None
-        width = np.arange(int(sizes[0]))
-        rows = np.concatenate([p.buffer[p.starts[:, None] + width] for p in info.parts])
+        width = int(sizes[0])
+        # Each part's payloads gathered as one L-byte item per message (an unaligned view of
+        # its buffer), straight into the (n, L) array.
+        rows = np.empty((sizes.size, width), np.uint8)
+        items = rows.view(f"V{width}").reshape(sizes.size) if width else None
+        done = 0
+        for part in info.parts:
+            count = part.starts.size
+            if items is not None:
+                items[done : done + count] = _unaligned(part.buffer, f"V{width}")[part.starts]
+            done += count
         return info.column("log_ns"), info.column("order"), rows
 
     def resolve(self, name: str) -> str:
@@ -354,7 +487,7 @@ class Bag:
         if not text:
             return None
         try:
-            scene = yaml.safe_load(text)
+            scene = yaml.load(text, Loader=_SAFE_LOADER)
         except yaml.YAMLError as exc:
             raise InputError(f"{str(self.path)!r}: the stored scene is not valid YAML ({exc})") from None
         return scene if isinstance(scene, dict) else None

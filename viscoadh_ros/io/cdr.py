@@ -19,6 +19,7 @@ from __future__ import annotations
 import functools
 import struct
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -155,10 +156,13 @@ def parse_command(payload: bytes) -> tuple[int, int, int, float, float] | None:
     return sec, nanosec, mode, depth, force
 
 
-def decode(type_name: str, payloads: Sequence[bytes] | NDArray[np.uint8]) -> dict[str, NDArray] | None:
+def decode(
+    type_name: str, payloads: Sequence[bytes] | NDArray[np.uint8], fields: Sequence[str] | None = None
+) -> dict[str, NDArray] | None:
     """Every field of ``payloads`` (n CDR messages of ``type_name``, or an (n, L) uint8 array of
-    them, see ``Bag.rows``) as arrays of shape (n,), plus ``stamp_ns`` (int64, ns) for stamped
-    types; None when they cannot be read in bulk."""
+    them, see ``Bag.rows``), or only ``fields``, as arrays of shape (n,), plus ``stamp_ns``
+    (int64, ns) for stamped types; None when they cannot be read in bulk. KeyError for a field
+    the type does not have."""
     if type_name not in _FIELDS or not len(payloads):
         return None
     if isinstance(payloads, np.ndarray):
@@ -183,7 +187,12 @@ def decode(type_name: str, payloads: Sequence[bytes] | NDArray[np.uint8]) -> dic
     records = head.view(layout).reshape(len(head))
     if stamped and np.any(records["frame_id.length"] != frame + 1):
         return None
-    columns = {name: records[name].copy() for name, _ in _FIELDS[type_name][1]}
+    known = [name for name, _ in _FIELDS[type_name][1]]
+    if fields is not None:
+        unknown = [name for name in fields if name not in known]
+        if unknown:
+            raise KeyError(f"{type_name} has no field {unknown[0]!r}")
+    columns = {name: records[name].copy() for name in (known if fields is None else fields)}
     if stamped:
         columns["stamp_ns"] = records["stamp.sec"].astype(np.int64) * 1_000_000_000 + records["stamp.nanosec"]
     return columns
@@ -204,23 +213,61 @@ def encode_array(
 ) -> NDArray[np.uint8]:
     """:func:`encode` as one (n, L) uint8 array: row k is the k-th payload (all of L bytes),
     for writers that take columns (``io.mcap_bulk.write_columns``)."""
-    stamps = np.asarray(stamp_ns, dtype=np.int64)
-    frame = frame_id.encode()
-    layout = _layout(type_name, len(frame))
-    records = np.zeros(stamps.shape[0], layout)
-    records["encapsulation"] = np.void(_ENCAPSULATION)
-    if _FIELDS[type_name][0]:
-        if np.any(stamps < 0):
-            raise ValueError(f"{type_name}: stamps must be >= 0 ns")
-        records["stamp.sec"], records["stamp.nanosec"] = np.divmod(stamps, 1_000_000_000)
-        records["frame_id.length"] = len(frame) + 1
-        records["frame_id"] = frame
-    known = {name for name, _ in _FIELDS[type_name][1]}
-    for name, values in fields.items():
-        if name not in known:
-            raise KeyError(f"{type_name} has no field {name!r}")
-        records[name] = values
-    return records.view(np.uint8).reshape(stamps.shape[0], layout.itemsize)
+    return Messages(type_name, np.asarray(stamp_ns, dtype=np.int64), frame_id, fields).rows()
+
+
+@dataclass(frozen=True)
+class Messages:
+    """n messages of ``type_name`` given by their columns, as :func:`encode_array` takes them
+    (``stamp_ns`` (n,) ns >= 0; ``fields`` arrays of shape (n,) or scalars, the rest zero),
+    for a writer that serialises them straight into its own buffer (:meth:`encode_into`,
+    ``io.mcap_bulk.write_columns``) instead of into an array of payloads first."""
+
+    type_name: str
+    stamp_ns: NDArray[np.int64]
+    frame_id: str
+    fields: Mapping[str, ArrayLike]
+
+    def __len__(self) -> int:
+        return int(np.shape(self.stamp_ns)[0])
+
+    @property
+    def layout(self) -> np.dtype:
+        """The structured dtype of one payload (itemsize = its size in bytes)."""
+        return _layout(self.type_name, len(self.frame_id.encode()))
+
+    def rows(self) -> NDArray[np.uint8]:
+        """The payloads as one (n, L) uint8 array."""
+        layout = self.layout
+        records = np.zeros(len(self), layout)
+        self.encode_into(records)
+        return records.view(np.uint8).reshape(len(self), layout.itemsize)
+
+    def check(self) -> None:
+        """ValueError for a negative stamp, KeyError for a field the type does not have."""
+        known = {name for name, _ in _FIELDS[self.type_name][1]}
+        unknown = [name for name in self.fields if name not in known]
+        if unknown:
+            raise KeyError(f"{self.type_name} has no field {unknown[0]!r}")
+        if _FIELDS[self.type_name][0] and np.any(np.asarray(self.stamp_ns) < 0):
+            raise ValueError(f"{self.type_name}: stamps must be >= 0 ns")
+
+    def encode_into(self, records: np.ndarray, first: int = 0) -> None:
+        """Serialise messages ``first`` to ``first + len(records)`` into ``records``: shape
+        (k,), dtype :attr:`layout`, any strides, every byte zero beforehand (padding and
+        fields not given stay zero). Checks (:meth:`check`) before writing."""
+        self.check()
+        end = first + len(records)
+        frame = self.frame_id.encode()
+        stamps = np.asarray(self.stamp_ns, dtype=np.int64)[first:end]
+        records["encapsulation"] = np.void(_ENCAPSULATION)
+        if _FIELDS[self.type_name][0]:
+            records["stamp.sec"], records["stamp.nanosec"] = np.divmod(stamps, 1_000_000_000)
+            records["frame_id.length"] = len(frame) + 1
+            records["frame_id"] = frame
+        for name, values in self.fields.items():
+            values = np.asarray(values)
+            records[name] = values[first:end] if values.ndim else values
 
 
 HAND_STATE = "viscoadh_msgs/msg/HandState"

@@ -4,10 +4,12 @@
 package's ``Writer`` (about 30 us per message in Python, more than replay's whole budget);
 :func:`write_columns` writes the same file from whole topics at once: the message records of
 a topic (fixed size when its payloads are, as :func:`viscoadh_ros.io.cdr.encode_array` makes
-them) are one numpy structured array, scattered in log-time order into one buffer that is cut
-into chunks; the message indexes are numpy arrays too. Only the handful of other records
-(header, schemas, channels, metadata, one Chunk/ChunkIndex per chunk, the summary) go through
-``mcap``'s record classes.
+them, or given as columns, :class:`viscoadh_ros.io.cdr.Messages`, serialised in place) are
+numpy structured arrays put in log-time order and cut into chunks; topics on the same log
+times (a state and its wrench per input) are built chunk by chunk into one reused block, so
+the file is never held whole. The message indexes are numpy arrays too. Only the handful of
+other records (header, schemas, channels, metadata, one ChunkIndex per chunk, the summary)
+go through ``mcap``'s record classes.
 
 The file follows what :class:`~viscoadh_ros.io.mcap_log.McapRecorder` writes (profile
 ``ros2``, ``ros2msg`` schemas, ``cdr`` channels with ``offered_qos_profiles``, the
@@ -32,7 +34,6 @@ from mcap.data_stream import RecordBuilder
 from mcap.opcode import Opcode
 from mcap.records import (
     Channel,
-    Chunk,
     ChunkIndex,
     DataEnd,
     Header,
@@ -44,6 +45,7 @@ from mcap.records import (
 from numpy.typing import NDArray
 
 from viscoadh_ros import __version__
+from viscoadh_ros.io import cdr
 from viscoadh_ros.io.mcap_log import (
     METADATA_NAME,
     SCENE_KEY,
@@ -67,10 +69,15 @@ _MESSAGE_HEAD = [
     ("publish_time", "<u8"),
 ]
 _HEAD_SIZE = 31
+#: A Chunk record up to its compression name's bytes: opcode, record length, message start
+#: and end time, uncompressed size, uncompressed CRC, compression name length (0: none).
+_CHUNK_HEAD = struct.Struct("<BQQQQII")
 
 
-def _as_rows(payloads: Sequence[bytes] | NDArray[np.uint8]) -> NDArray[np.uint8] | None:
+def _as_rows(payloads: Any) -> NDArray[np.uint8] | None:
     """The payloads as an (n, L) uint8 array when they all have one length, else None."""
+    if isinstance(payloads, cdr.Messages):
+        return payloads.rows()
     if isinstance(payloads, np.ndarray):
         return payloads if payloads.ndim == 2 else None
     if not len(payloads):
@@ -81,23 +88,52 @@ def _as_rows(payloads: Sequence[bytes] | NDArray[np.uint8]) -> NDArray[np.uint8]
     return np.frombuffer(b"".join(payloads), np.uint8).reshape(len(payloads), length)
 
 
+def _fixed(payloads: Any) -> NDArray[np.uint8] | cdr.Messages | None:
+    """Payloads of one length as they can be written in place (an (n, L) array or the
+    messages' columns), else None."""
+    return payloads if isinstance(payloads, cdr.Messages) else _as_rows(payloads)
+
+
+def _size(payloads: NDArray[np.uint8] | cdr.Messages) -> int:
+    return payloads.layout.itemsize if isinstance(payloads, cdr.Messages) else payloads.shape[1]
+
+
+def _head_layout(length: int) -> np.dtype:
+    """One message record with a payload of ``length`` bytes (no padding)."""
+    return np.dtype(_MESSAGE_HEAD + [("data", f"V{length}")] if length else _MESSAGE_HEAD)
+
+
+def _fill(
+    records: np.ndarray,
+    channel: int,
+    log_ns: NDArray[np.int64],
+    payloads: NDArray[np.uint8] | cdr.Messages,
+    first: int = 0,
+) -> None:
+    """Write messages ``first`` to ``first + len(records)`` of a topic as message records (a
+    zeroed structured array of :func:`_head_layout`) in place."""
+    end, length = first + len(records), _size(payloads)
+    records["opcode"] = Opcode.MESSAGE
+    records["length"] = _HEAD_SIZE - 9 + length
+    records["channel"] = channel
+    records["sequence"] = np.arange(first, end, dtype=np.uint32)
+    records["log_time"] = log_ns[first:end]
+    records["publish_time"] = log_ns[first:end]
+    if isinstance(payloads, cdr.Messages):
+        payloads.encode_into(records["data"].view(payloads.layout), first)
+    elif length:
+        records["data"] = payloads[first:end].view(f"V{length}").reshape(end - first)
+
+
 def _records(channel: int, log_ns: NDArray[np.int64], payloads: Any) -> tuple[NDArray[np.uint8], NDArray]:
     """``(bytes, sizes)``: the message records of one topic, concatenated, and each one's size."""
-    rows = _as_rows(payloads)
+    fixed = _fixed(payloads)
     n = len(log_ns)
-    if rows is not None:
-        length = rows.shape[1]
-        layout = np.dtype(_MESSAGE_HEAD + [("data", f"V{length}")] if length else _MESSAGE_HEAD)
-        records = np.empty(n, layout)
-        records["opcode"] = Opcode.MESSAGE
-        records["length"] = _HEAD_SIZE - 9 + length
-        records["channel"] = channel
-        records["sequence"] = np.arange(n, dtype=np.uint32)
-        records["log_time"] = log_ns
-        records["publish_time"] = log_ns
-        if length:
-            records["data"] = rows.view(f"V{length}").reshape(n)
-        return np.frombuffer(records.tobytes(), np.uint8), np.full(n, layout.itemsize, dtype=np.int64)
+    if fixed is not None:
+        layout = _head_layout(_size(fixed))
+        records = np.zeros(n, layout)
+        _fill(records, channel, log_ns, fixed)
+        return records.view(np.uint8), np.full(n, layout.itemsize, dtype=np.int64)
     # Payloads of several lengths: one small header per message, joined in one pass.
     heads = struct.Struct("<BQHIQQ")
     parts = []
@@ -106,6 +142,66 @@ def _records(channel: int, log_ns: NDArray[np.int64], payloads: Any) -> tuple[ND
         parts.append(bytes(data))
     sizes = np.array([_HEAD_SIZE + len(p) for p in payloads], dtype=np.int64)
     return np.frombuffer(b"".join(parts), np.uint8), sizes
+
+
+class _SideBySide:
+    """Topics whose payloads all have one length, on the same non-decreasing log times (a
+    state and its wrench per input): in file order the k-th records of the topics lie side by
+    side, one structured row per k. A chunk's bytes are built when it is written, into one
+    reused block of rows (filled and, for messages given as columns, serialised in place),
+    so the file is never held whole and each row is written while it is in the cache."""
+
+    def __init__(self, log_ns: NDArray[np.int64], fixed: list[NDArray[np.uint8] | cdr.Messages]) -> None:
+        self.log_ns, self.fixed = log_ns, fixed
+        layouts = [_head_layout(_size(f)) for f in fixed]
+        offsets = np.cumsum([0] + [lay.itemsize for lay in layouts])
+        self.names = [f"t{t}" for t in range(len(fixed))]
+        self.row = np.dtype(
+            {
+                "names": self.names,
+                "formats": layouts,
+                "offsets": offsets[:-1].tolist(),
+                "itemsize": int(offsets[-1]),
+            }
+        )
+        n, count = log_ns.size, len(fixed)
+        self.count = count
+        self.sizes = np.tile(np.array([lay.itemsize for lay in layouts], dtype=np.int64), n)
+        self.which = np.tile(np.arange(count), n)
+        self.times = np.repeat(log_ns, count)
+        self._block = np.empty(0, self.row)
+
+    @staticmethod
+    def plan(log_ns: list[NDArray[np.int64]], payloads: list[Any]) -> _SideBySide | None:
+        """The topics as side-by-side rows, or None when they are not like that."""
+        n = log_ns[0].size
+        if len(payloads) < 2 or n == 0:
+            return None
+        if not all(ns.shape == (n,) and np.array_equal(ns, log_ns[0]) for ns in log_ns[1:]):
+            return None
+        if np.any(np.diff(log_ns[0]) < 0):
+            return None
+        fixed = [_fixed(p) for p in payloads]
+        if any(f is None for f in fixed):
+            return None
+        for f in fixed:
+            if isinstance(f, cdr.Messages):
+                f.check()  # before the file is opened
+        return _SideBySide(log_ns[0], fixed)  # type: ignore[arg-type]
+
+    def chunk(self, lo: int, hi: int, first: int, end: int) -> memoryview:
+        """The bytes of records ``lo`` to ``hi`` (file-order indexes), stream offsets ``first``
+        to ``end``; valid until the next call."""
+        k0, k1 = lo // self.count, (hi - 1) // self.count + 1
+        if self._block.size < k1 - k0:
+            self._block = np.empty(k1 - k0, self.row)
+        block = self._block[: k1 - k0]
+        raw = block.view(np.uint8)
+        raw[:] = 0
+        for t, (name, data) in enumerate(zip(self.names, self.fixed, strict=True)):
+            _fill(block[name], t + 1, self.log_ns, data, k0)
+        offset = first - k0 * self.row.itemsize
+        return memoryview(raw[offset : offset + end - first])
 
 
 def write_columns(
@@ -117,8 +213,10 @@ def write_columns(
 ) -> None:
     """Write a finished MCAP file of whole topics at once (see the module docstring).
 
-    ``TopicData.payloads`` may be a list of CDR payloads or an (n, L) uint8 array of n
-    payloads of L bytes (:func:`viscoadh_ros.io.cdr.encode_array`), the fast case.
+    ``TopicData.payloads`` may be a list of CDR payloads, an (n, L) uint8 array of n
+    payloads of L bytes (:func:`viscoadh_ros.io.cdr.encode_array`), or a
+    :class:`viscoadh_ros.io.cdr.Messages` (the columns of n messages, serialised straight
+    into the file's records: the fast case).
     """
     for data in topics:
         if len(data.log_ns) != len(data.payloads):
@@ -126,17 +224,29 @@ def write_columns(
     log_ns = [np.asarray(d.log_ns, dtype=np.int64) for d in topics]
     if any(np.any(ns < 0) for ns in log_ns):
         raise ValueError("log times must be >= 0 ns")
-    # Every topic's records, then one buffer in log-time order (ties as write_mcap breaks them).
-    built = [_records(t + 1, ns, d.payloads) for t, (ns, d) in enumerate(zip(log_ns, topics, strict=True))]
-    stream, sizes, which, times = _ordered(log_ns, built)
+    # Every topic's records in log-time order (ties as write_mcap breaks them): built chunk by
+    # chunk for side-by-side topics, else in one buffer.
+    plan = _SideBySide.plan(log_ns, [d.payloads for d in topics]) if topics else None
+    if plan is not None:
+        sizes, which, times = plan.sizes, plan.which, plan.times
+        chunk_bytes = plan.chunk
+    else:
+        built = [
+            _records(t + 1, ns, d.payloads) for t, (ns, d) in enumerate(zip(log_ns, topics, strict=True))
+        ]
+        stream, sizes, which, times = _ordered(log_ns, built)
+
+        def chunk_bytes(lo: int, hi: int, first: int, end: int) -> memoryview:
+            return memoryview(stream[first:end])
+
     starts = np.cumsum(sizes) - sizes  # of each message record in the ordered stream
 
     builder = RecordBuilder()
-    out = bytearray(_MAGIC)
+    head = bytearray(_MAGIC)
     Header(profile="ros2", library=f"viscoadh_ros {__version__}").write(builder)
-    metadata_offset = len(out) + builder.count
+    metadata_offset = len(head) + builder.count
     Metadata(name=METADATA_NAME, metadata=_metadata(scene)).write(builder)
-    metadata_length = len(out) + builder.count - metadata_offset
+    metadata_length = len(head) + builder.count - metadata_offset
     schemas: dict[str, Schema] = {}
     channels: list[Channel] = []
     qos = TopicQos().to_yaml()
@@ -159,66 +269,94 @@ def write_columns(
         )
         channels.append(channel)
         channel.write(builder)
-    out += builder.end()
+    head += builder.end()
 
-    # Chunks: consecutive messages up to about chunk_size bytes each.
+    # Chunks: consecutive messages up to about chunk_size bytes each. The records are written
+    # to the file straight from `stream` (no copy per chunk); the message indexes of all
+    # chunks are one array sorted by (chunk, channel), cut into one record per pair.
     chunk_of = starts // max(int(chunk_size), 1)
-    bounds = np.flatnonzero(np.diff(chunk_of)) + 1
-    chunk_indexes = []
-    for lo, hi in zip(np.concatenate(([0], bounds)), np.concatenate((bounds, [sizes.size])), strict=True):
-        if hi <= lo:
-            continue
-        first, end = int(starts[lo]), int(starts[hi - 1] + sizes[hi - 1])
-        data = stream[first:end].tobytes()
-        chunk = Chunk(
-            compression="",
-            data=data,
-            message_start_time=int(times[lo:hi].min()),
-            message_end_time=int(times[lo:hi].max()),
-            uncompressed_crc=zlib.crc32(data),
-            uncompressed_size=len(data),
-        )
-        chunk_start = len(out)
-        chunk.write(builder)
-        out += builder.end()
-        index_start = len(out)
-        offsets: dict[int, int] = {}
-        for t in np.unique(which[lo:hi]).tolist():
-            mine = np.flatnonzero(which[lo:hi] == t) + lo
-            entries = np.empty(mine.size, [("log_time", "<u8"), ("offset", "<u8")])
-            entries["log_time"] = times[mine]
-            entries["offset"] = starts[mine] - first
-            body = entries.tobytes()
-            offsets[t + 1] = len(out)
-            out += struct.pack("<BQHI", Opcode.MESSAGE_INDEX, 2 + 4 + len(body), t + 1, len(body)) + body
-        chunk_indexes.append(
-            ChunkIndex(
-                message_start_time=chunk.message_start_time,
-                message_end_time=chunk.message_end_time,
-                chunk_start_offset=chunk_start,
-                chunk_length=index_start - chunk_start,
-                message_index_offsets=offsets,
-                message_index_length=len(out) - index_start,
-                compression="",
-                compressed_size=len(data),
-                uncompressed_size=len(data),
-            )
-        )
-    DataEnd(data_section_crc=zlib.crc32(out)).write(builder)
-    out += builder.end()
-
-    sections = (
-        (Opcode.SCHEMA, list(schemas.values())),
-        (Opcode.CHANNEL, channels),
-        (Opcode.STATISTICS, [_statistics(which, times, len(schemas), len(channels), len(chunk_indexes))]),
-        (Opcode.CHUNK_INDEX, chunk_indexes),
-        (
-            Opcode.METADATA_INDEX,
-            [MetadataIndex(offset=metadata_offset, length=metadata_length, name=METADATA_NAME)],
-        ),
+    firsts = (
+        np.concatenate(([0], np.flatnonzero(np.diff(chunk_of)) + 1)) if sizes.size else np.zeros(0, np.int64)
     )
-    out += summary_and_footer(builder, len(out), sections)
-    Path(path).write_bytes(out)
+    lasts = np.concatenate((firsts[1:], [sizes.size])) if sizes.size else firsts
+    chunk = np.repeat(np.arange(firsts.size), lasts - firsts)
+    entries = np.empty(sizes.size, [("log_time", "<u8"), ("offset", "<u8")])
+    entries["log_time"] = times
+    entries["offset"] = starts - starts[firsts][chunk]
+    count = len(topics)
+    by_channel = np.argsort(chunk * count + which, kind="stable")
+    entries = entries[by_channel]
+    pair_counts = np.bincount(chunk * count + which, minlength=firsts.size * count).reshape(
+        firsts.size, count
+    )
+    pair_ends = np.cumsum(pair_counts.reshape(-1)).reshape(firsts.size, count)
+    start_times = np.minimum.reduceat(times, firsts) if sizes.size else firsts
+    end_times = np.maximum.reduceat(times, firsts) if sizes.size else firsts
+    chunk_indexes = []
+    path = Path(path)
+    try:
+        with open(path, "wb") as out:
+            out.write(head)
+            position, crc = len(head), zlib.crc32(head)
+            for c, (lo, hi) in enumerate(zip(firsts.tolist(), lasts.tolist(), strict=True)):
+                first, end = int(starts[lo]), int(starts[hi - 1] + sizes[hi - 1])
+                data = chunk_bytes(lo, hi, first, end)
+                data_crc = zlib.crc32(data)
+                chunk_head = _CHUNK_HEAD.pack(
+                    Opcode.CHUNK,
+                    40 + len(data),
+                    int(start_times[c]),
+                    int(end_times[c]),
+                    len(data),
+                    data_crc,
+                    0,
+                ) + struct.pack("<Q", len(data))
+                chunk_start = position
+                indexes = bytearray()
+                offsets: dict[int, int] = {}
+                index_start = position + len(chunk_head) + len(data)
+                for t in np.flatnonzero(pair_counts[c]).tolist():
+                    body = entries[pair_ends[c, t] - pair_counts[c, t] : pair_ends[c, t]].tobytes()
+                    offsets[t + 1] = index_start + len(indexes)
+                    indexes += struct.pack("<BQHI", Opcode.MESSAGE_INDEX, 2 + 4 + len(body), t + 1, len(body))
+                    indexes += body
+                for piece in (chunk_head, data, indexes):
+                    out.write(piece)
+                    crc = zlib.crc32(piece, crc)
+                position = index_start + len(indexes)
+                chunk_indexes.append(
+                    ChunkIndex(
+                        message_start_time=int(start_times[c]),
+                        message_end_time=int(end_times[c]),
+                        chunk_start_offset=chunk_start,
+                        chunk_length=index_start - chunk_start,
+                        message_index_offsets=offsets,
+                        message_index_length=len(indexes),
+                        compression="",
+                        compressed_size=len(data),
+                        uncompressed_size=len(data),
+                    )
+                )
+            DataEnd(data_section_crc=crc).write(builder)
+            tail = builder.end()
+            position += len(tail)
+            sections = (
+                (Opcode.SCHEMA, list(schemas.values())),
+                (Opcode.CHANNEL, channels),
+                (
+                    Opcode.STATISTICS,
+                    [_statistics(which, times, len(schemas), len(channels), len(chunk_indexes))],
+                ),
+                (Opcode.CHUNK_INDEX, chunk_indexes),
+                (
+                    Opcode.METADATA_INDEX,
+                    [MetadataIndex(offset=metadata_offset, length=metadata_length, name=METADATA_NAME)],
+                ),
+            )
+            out.write(tail + summary_and_footer(builder, position, sections))
+    except BaseException:
+        path.unlink(missing_ok=True)  # never leave a half-written file
+        raise
 
 
 def _ordered(
@@ -229,16 +367,6 @@ def _ordered(
     if not built:
         empty = np.zeros(0, np.int64)
         return np.zeros(0, np.uint8), empty, empty, empty
-    n = log_ns[0].size
-    shared = all(ns.shape == (n,) and np.array_equal(ns, log_ns[0]) for ns in log_ns)
-    fixed = all(b.size == sizes.sum() and (n == 0 or np.all(sizes == sizes[0])) for b, sizes in built)
-    if len(built) > 1 and shared and fixed and np.all(np.diff(log_ns[0]) >= 0):
-        # Topics on the same non-decreasing log times (a state and its wrench per input): the
-        # order is the k-th message of each topic in turn, i.e. the topics' rows side by side.
-        count = len(built)
-        stream = np.concatenate([b.reshape(n, -1) for b, _ in built], axis=1).reshape(-1)
-        sizes = np.tile(np.array([s[0] for _, s in built], dtype=np.int64), n)
-        return stream, sizes, np.tile(np.arange(count), n), np.repeat(log_ns[0], count)
     which = np.concatenate([np.full(len(ns), t, dtype=np.int64) for t, ns in enumerate(log_ns)])
     index = np.concatenate([np.arange(len(ns), dtype=np.int64) for ns in log_ns])
     times = np.concatenate(log_ns)
