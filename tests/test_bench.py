@@ -326,6 +326,9 @@ def test_replay_speed_reports_stage_shares() -> None:
     assert result["realtime_factor"] > 0.0
     assert set(result["time_share"]) == {"decode", "simulate", "encode and compare"}
     assert all(0.0 <= share <= 1.0 for share in result["time_share"].values())
+    # The reachable floor: the minimal stepper over the same history, plus replay's own cost.
+    assert result["minimal_us_per_command"] > 0.0
+    assert 0.0 < result["floor_realtime_factor"] < float("inf")
 
 
 def test_report_marks_targets() -> None:

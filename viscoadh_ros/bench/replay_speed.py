@@ -10,7 +10,10 @@ writing, the Python around the simulator calls), per run, so the split does not 
 another run's noise. Beside it, interleaved: decode alone (open the bag, read the experiment)
 and `ContactSimulator.step_depths` alone over the same depth history from a fresh simulator
 (the compiled stepper with no replay around it: what simulate would cost if replay added
-nothing).
+nothing), and the bench's minimal compiled stepper (`bench.reference_stepper.MinimalStepper`)
+over the same history on the product's final grid: the floor a correct program of this model
+reaches at these numerics, so the 500x target can be read against what is reachable
+(``floor_realtime_factor``: the minimal stepper plus replay's own non-simulation cost).
 """
 
 from __future__ import annotations
@@ -99,11 +102,13 @@ def replay_benchmark(*, seconds: float, repeats: int) -> dict[str, Any]:
 
         whole()  # imports and compiled code loaded once, outside the timing
         inner.clear()
+        minimal_run = _minimal_run(contact, times, depths)
         samples = interleaved_samples(
             {
                 "total": whole,
                 "decode": lambda: load_experiment(Bag(bag_path)),
                 "step_depths": lambda: ContactSimulator(contact).step_depths(times, depths),
+                "minimal": minimal_run,
             },
             repeats=repeats,
         )
@@ -113,6 +118,7 @@ def replay_benchmark(*, seconds: float, repeats: int) -> dict[str, Any]:
     rest = float(np.median(np.array(samples["total"]) - np.array(inner)))
     decode = min(float(np.median(samples["decode"])), rest)
     bare = float(np.median(samples["step_depths"]))
+    minimal = float(np.median(samples["minimal"]))
     # Shares of the whole run: simulate measured inside it, decode timed apart (capped at the
     # run's non-simulation time), encode and compare the remainder.
     stages = {"decode": decode, "simulate": simulate, "encode and compare": max(0.0, rest - decode)}
@@ -127,5 +133,42 @@ def replay_benchmark(*, seconds: float, repeats: int) -> dict[str, Any]:
         "simulate_us_per_command": simulate / commands * 1e6,
         "non_simulation_us_per_command": rest / commands * 1e6,
         "step_depths_us_per_command": bare / commands * 1e6,
+        "minimal_us_per_command": minimal / commands * 1e6,
+        "floor_realtime_factor": duration / (minimal + rest),
         "time_share": {stage: value / stage_sum for stage, value in stages.items()},
     }
+
+
+def _minimal_run(contact: Any, times: Any, depths: Any) -> Any:
+    """A callable running `MinimalStepper` over the depth history at its fixed step, from rest,
+    on the grid the product builds for the history's deepest press (a history that never
+    touches: for a press of one nanometre)."""
+    import numpy as np
+
+    from viscoadh_ros.bench.reference_stepper import MinimalStepper
+    from viscoadh_ros.core.simulator import ContactSimulator
+
+    steps = np.diff(times)
+    if steps.size == 0 or not np.allclose(steps, steps[0], rtol=1e-6):
+        raise RuntimeError("the replay bench's minimal stepper needs a fixed command period")
+    simulator = ContactSimulator(contact)
+    simulator.step(float(steps[0]), depth=max(float(np.max(depths)), 1e-9))
+    model = simulator._model  # the bench reads the product's grid, as the kernel section does
+    row = model.row
+    minimal = MinimalStepper(
+        g_centres=row.g_c,
+        dx=row.dx,
+        e0=simulator.physics.e0,
+        e_kelvin=model.e_kelvin,
+        eta_kelvin=model.e_kelvin / model.rate if model.e_kelvin.size else np.zeros(0),
+        c_crit=simulator.physics.c_crit,
+    )
+    memory = np.zeros_like(row.wl)
+    dt = float(steps[0])
+
+    def run() -> None:
+        minimal.set_state(depth=float(depths[0]), radius=0.0, memory=memory)
+        minimal.run(dt, depths[1:])
+
+    run()  # compiled outside the timing
+    return run

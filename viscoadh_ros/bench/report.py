@@ -503,6 +503,15 @@ def render_markdown(results: dict[str, Any], figure: Path | None, notes: str | N
                 f"{_g(replay['non_simulation_us_per_command'])} us.",
                 "",
             ]
+        if "minimal_us_per_command" in replay:
+            lines += [
+                f"The floor at these numerics: the bench's minimal compiled stepper "
+                f"(`bench.reference_stepper.MinimalStepper`) over the same history on the product's "
+                f"grid costs {_g(replay['minimal_us_per_command'])} us per command, so a replay with "
+                f"that stepper and this run's non-simulation cost would reach "
+                f"{_g(replay['floor_realtime_factor'])}x real time.",
+                "",
+            ]
         lines += _table(
             ["stage", "share of time"],
             [[stage, f"{share:.1%}"] for stage, share in replay["time_share"].items()],
