@@ -39,6 +39,7 @@ annulus gives up the surface energy ``2 pi x w dx = E0* c^2 x dx`` loses the dif
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numba
@@ -1743,6 +1744,25 @@ def _stored_energy(a, d, wl, wb, dx, g_c, gf, df, e0, e_kelvin):
     return total
 
 
+@numba.njit(cache=True, nogil=True)
+def _block_extremes(gf, gmin, gmax):
+    """Least and largest of each block of `TOUCH_BLOCK` points of ``gf`` (finite) into
+    ``gmin``/``gmax``: ``np.minimum.reduceat`` / ``np.maximum.reduceat`` over the block starts
+    (the extremes of finite values are exact; test_row_regrid pins them equal)."""
+    m = gf.shape[0]
+    for b in range(gmin.shape[0]):
+        j0 = b * TOUCH_BLOCK
+        j1 = min(j0 + TOUCH_BLOCK, m)
+        least = gf[j0]
+        most = gf[j0]
+        for j in range(j0 + 1, j1):
+            v = gf[j]
+            least = min(least, v)
+            most = max(most, v)
+        gmin[b] = least
+        gmax[b] = most
+
+
 # ----------------------------------------------------------------------------------------
 # Public wrappers: validate, then call the compiled kernel.
 
@@ -1778,6 +1798,7 @@ def _check_scalars(**values: float) -> None:
 PACK_HEADER = 10
 
 
+@functools.lru_cache(maxsize=256)
 def _state_layout(n: int, k: int) -> tuple[tuple[str, tuple[int, ...]], ...]:
     """The arrays in `Row._state`, in order, with their shapes (`_unpack` mirrors it)."""
     return (
@@ -1796,6 +1817,7 @@ def _state_layout(n: int, k: int) -> tuple[tuple[str, tuple[int, ...]], ...]:
     )
 
 
+@functools.lru_cache(maxsize=256)
 def _const_layout(n: int, k: int, m: int, blocks: int) -> tuple[tuple[str, tuple[int, ...]], ...]:
     """The arrays in `Row._const` after the header, in order (`_unpack` mirrors it)."""
     return (
@@ -1820,13 +1842,25 @@ def _arena_size(layout: tuple[tuple[str, tuple[int, ...]], ...], start: int) -> 
     return start + sum(math.prod(shape) for _, shape in layout)
 
 
-def _views(buffer: np.ndarray, start: int, layout: tuple[tuple[str, tuple[int, ...]], ...]):
-    """(name, view) of each array of `layout` in `buffer` from `start` on."""
+@functools.lru_cache(maxsize=256)
+def _slots(
+    start: int, layout: tuple[tuple[str, tuple[int, ...]], ...]
+) -> tuple[tuple[str, int, int, tuple[int, ...]], ...]:
+    """(name, first, end, shape) of each array of `layout` from `start` on (cached: a domain
+    growth rebinds two dozen views and the layout of a row size repeats)."""
+    slots = []
     offset = start
     for name, shape in layout:
         size = math.prod(shape)
-        yield name, buffer[offset : offset + size].reshape(shape)
+        slots.append((name, offset, offset + size, shape))
         offset += size
+    return tuple(slots)
+
+
+def _views(buffer: np.ndarray, start: int, layout: tuple[tuple[str, tuple[int, ...]], ...]):
+    """(name, view) of each array of `layout` in `buffer` from `start` on."""
+    for name, first, end, shape in _slots(start, layout):
+        yield name, buffer[first:end].reshape(shape)
 
 
 @intrinsic
@@ -2052,6 +2086,70 @@ class Row:
         # `txn`, `txn_b`: the simulator's transaction journal, the memory before a step's first
         # kernel call; `scratch`, `scratch_b`, `diss`, `out`: the kernel's work and output slots.
         self._kernel_args: tuple | None = None
+
+    def regrid(
+        self,
+        *,
+        dx: float,
+        g_c: np.ndarray,
+        gf: np.ndarray,
+        gint: np.ndarray,
+        df: float,
+        reach: float,
+        wl: np.ndarray,
+        wb: np.ndarray | None = None,
+    ) -> Row:
+        """A new row of this row's chain and constants (``p`` .. ``e_kelvin``, ``steady``,
+        ``e0``, ``c_crit``: copied, already checked) on a new grid: the arguments as for
+        `Row` (``wl`` keeps this row's Kelvin count). The same buffers, bit for bit, as
+        `Row` given this row's chain; cheaper (a domain growth builds one inside a step):
+        the chain is copied as one block and not checked again, the block extremes of the
+        fine profile are one compiled pass."""
+        k = self.wl.shape[1]
+        if wl.ndim != 2 or wl.shape[1] != k:
+            raise ValueError(f"wl must have shape (N, {k}) (got {getattr(wl, 'shape', None)})")
+        n = wl.shape[0]
+        m = gf.shape[0]
+        _check_scalars(dx=dx, df=df)
+        if dx <= 0.0 or df <= 0.0 or m < 2 or n < 1:
+            raise ValueError("row needs dx > 0, df > 0, at least 1 element and 2 fine points")
+        if not reach > 0.0:
+            raise ValueError(f"reach must be > 0 (got {reach!r})")
+        if wb is None:
+            wb = np.zeros_like(wl)
+        for name, array, shape in (
+            ("g_c", g_c, (n,)),
+            ("gf", gf, (m,)),
+            ("gint", gint, (m,)),
+            ("wl", wl, (n, k)),
+            ("wb", wb, (n, k)),
+        ):
+            _check(name, array, shape)
+        row = object.__new__(Row)
+        row.dx, row.df, row.reach = float(dx), float(df), float(reach)
+        row.e0, row.c_crit = self.e0, self.c_crit
+        row.steady = self.steady
+        row.kap = self.kap
+        blocks = (m + TOUCH_BLOCK - 1) // TOUCH_BLOCK
+        row._const = np.empty(_arena_size(_const_layout(n, k, m, blocks), PACK_HEADER))
+        row._const[:PACK_HEADER] = (n, k, m, blocks, row.dx, row.df, row.e0, row.c_crit, row.reach, row.kap)
+        row._state = np.zeros(_arena_size(_state_layout(n, k), 0))
+        row._attach_views()
+        row.coef[...] = coefficient_workspace(k)
+        row.g_c[...] = g_c
+        row.gf[...] = gf
+        row.gint[...] = gint
+        _block_extremes(gf, row.gmin, row.gmax)
+        # The chain (p .. e_kelvin) closes both layouts: one contiguous block.
+        chain = 2 * k * k + 4 * k
+        if chain:
+            row._const[-chain:] = self._const[-chain:]
+        row.wl[...] = wl
+        row.wb[...] = wb
+        row.wsum[...] = row.wl.sum(axis=1)
+        row.bsum[...] = row.wb.sum(axis=1)
+        row._kernel_args = None
+        return row
 
     def _attach_views(self) -> None:
         """(Re)bind the array attributes to their places in `_const` and `_state`."""
@@ -2323,6 +2421,15 @@ def warm_up() -> None:
         steady=0.5 * one,
         e0=1.0,
         c_crit=0.1,
+    )
+    row.regrid(
+        dx=0.25,
+        g_c=row.g_c.copy(),
+        gf=row.gf.copy(),
+        gint=row.gint.copy(),
+        df=row.df,
+        reach=row.reach,
+        wl=np.zeros((n, k)),
     )
     advance(row, 0.0, 0.0, 0.1, 0.01, max_substep=0.0, max_edge_move=0.25)
     advance(row, 0.3, 0.1, 0.2, 0.0, max_substep=0.0, max_edge_move=0.25)
