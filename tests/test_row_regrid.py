@@ -96,7 +96,9 @@ def _assert_same(new: _kernels.Row, old: _kernels.Row, label: str) -> None:
         assert getattr(new, name) == getattr(old, name), f"{label}: {name}"
     np.testing.assert_array_equal(new.steady, old.steady)
     for name in _kernels._VIEW_NAMES:
-        if getattr(new, name).size == 0:
+        view, expected = getattr(new, name), getattr(old, name)
+        assert view.shape == expected.shape and view.tobytes() == expected.tobytes(), f"{label}: {name}"
+        if view.size == 0:
             continue  # K = 0: the chain's arrays are empty
         assert np.shares_memory(getattr(new, name), new._const if name in _CONST else new._state), name
 

@@ -1763,6 +1763,43 @@ def _block_extremes(gf, gmin, gmax):
         gmax[b] = most
 
 
+@numba.njit(cache=True, nogil=True)
+def _fill_regrid(const, state, chain_from, g_c, gf, gint, wl, wb, dx, df, e0, c_crit, reach, kap):
+    """`Row.regrid`'s buffers: ``const`` (header, geometry, block extremes, the chain copied
+    from the end of ``chain_from``) and ``state`` (zeros on entry: the memory, the coefficient
+    workspace holding no substep) in the order of `_const_layout` and `_state_layout`."""
+    n, k = wl.shape
+    m = gf.shape[0]
+    blocks = (m + TOUCH_BLOCK - 1) // TOUCH_BLOCK
+    const[0] = n
+    const[1] = k
+    const[2] = m
+    const[3] = blocks
+    const[4] = dx
+    const[5] = df
+    const[6] = e0
+    const[7] = c_crit
+    const[8] = reach
+    const[9] = kap
+    at = PACK_HEADER
+    const[at : at + n] = g_c
+    at += n
+    const[at : at + m] = gf
+    at += m
+    const[at : at + m] = gint
+    at += m
+    _block_extremes(gf, const[at : at + blocks], const[at + blocks : at + 2 * blocks])
+    at += 2 * blocks
+    chain = 2 * k * k + 4 * k
+    const[at : at + chain] = chain_from[chain_from.shape[0] - chain :]
+    # state: wl, wsum, wb, bsum, scratch, scratch_b, diss, out, txn, txn_b, coef
+    size = n * k
+    state[0:size] = wl.reshape(size)
+    at = size + n
+    state[at : at + size] = wb.reshape(size)
+    state[state.shape[0] - COEF_ROWS * max(k, 1) + _C_SUBSTEP * max(k, 1)] = np.nan
+
+
 # ----------------------------------------------------------------------------------------
 # Public wrappers: validate, then call the compiled kernel.
 
@@ -1855,6 +1892,14 @@ def _slots(
         slots.append((name, offset, offset + size, shape))
         offset += size
     return tuple(slots)
+
+
+@functools.lru_cache(maxsize=256)
+def _slot_map(
+    start: int, layout: tuple[tuple[str, tuple[int, ...]], ...]
+) -> dict[str, tuple[int, int, tuple[int, ...]]]:
+    """`_slots` by name: (first, end, shape). Cached; never mutate the result."""
+    return {name: (first, end, shape) for name, first, end, shape in _slots(start, layout)}
 
 
 def _views(buffer: np.ndarray, start: int, layout: tuple[tuple[str, tuple[int, ...]], ...]):
@@ -2132,24 +2177,47 @@ class Row:
         row.kap = self.kap
         blocks = (m + TOUCH_BLOCK - 1) // TOUCH_BLOCK
         row._const = np.empty(_arena_size(_const_layout(n, k, m, blocks), PACK_HEADER))
-        row._const[:PACK_HEADER] = (n, k, m, blocks, row.dx, row.df, row.e0, row.c_crit, row.reach, row.kap)
         row._state = np.zeros(_arena_size(_state_layout(n, k), 0))
-        row._attach_views()
-        row.coef[...] = coefficient_workspace(k)
-        row.g_c[...] = g_c
-        row.gf[...] = gf
-        row.gint[...] = gint
-        _block_extremes(gf, row.gmin, row.gmax)
-        # The chain (p .. e_kelvin) closes both layouts: one contiguous block.
-        chain = 2 * k * k + 4 * k
-        if chain:
-            row._const[-chain:] = self._const[-chain:]
-        row.wl[...] = wl
-        row.wb[...] = wb
-        row.wsum[...] = row.wl.sum(axis=1)
-        row.bsum[...] = row.wb.sum(axis=1)
+        # One compiled call fills both buffers (a growth builds this row inside a step, where
+        # each Python statement costs several microseconds); the views are bound on first
+        # use (`__getattr__`). The sums of the memory stay numpy's (its summation order).
+        _fill_regrid(
+            row._const,
+            row._state,
+            self._const,
+            g_c,
+            gf,
+            gint,
+            np.ascontiguousarray(wl),
+            np.ascontiguousarray(wb),
+            row.dx,
+            row.df,
+            row.e0,
+            row.c_crit,
+            row.reach,
+            row.kap,
+        )
+        np.sum(row.wl, axis=1, out=row.wsum)
+        np.sum(row.wb, axis=1, out=row.bsum)
         row._kernel_args = None
         return row
+
+    def __getattr__(self, name: str) -> np.ndarray:
+        """An array view not bound yet (`regrid` binds them on first use): bind it now."""
+        fields = self.__dict__
+        if name in _VIEW_NAMES and "_const" in fields and "_state" in fields:
+            const = fields["_const"]
+            n, k, m, blocks = (int(v) for v in const[:4])
+            at = _slot_map(PACK_HEADER, _const_layout(n, k, m, blocks))
+            buffer = const
+            if name not in at:
+                at = _slot_map(0, _state_layout(n, k))
+                buffer = fields["_state"]
+            first, end, shape = at[name]
+            view = buffer[first:end].reshape(shape)
+            fields[name] = view
+            return view
+        raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
 
     def _attach_views(self) -> None:
         """(Re)bind the array attributes to their places in `_const` and `_state`."""
