@@ -115,6 +115,7 @@ def test_build_and_grow_match_the_reference_builder(indenter: str, chain: str) -
         k = model.e_kelvin.size
         for length in (3.3e-6, 1.7e-4, 2.5e-4, 1e-3, 4.1e-3):
             memory = rng.normal(scale=2e-6, size=(elements, k))
+            memory[::3] = -0.0  # numpy's sum turns a -0.0 into +0.0: the fill must too
             unit = rng.uniform(size=(elements, k)) * model.steady
             label = f"{indenter} {chain} N={elements} L={length}"
             built = model._build_row(length, memory.copy(), unit.copy())
@@ -193,8 +194,13 @@ def test_regrid_refuses_bad_input_and_changes_nothing() -> None:
     for name, value, error in bad_values:
         with pytest.raises(error):
             row.regrid(**{**good, name: value})
-    with pytest.raises(ValueError):
+    with pytest.raises(ValueError, match="wb must be finite"):
         row.regrid(**good, wb=np.full((12, 1), math.nan))
+    for name in ("g_c", "gint", "wl"):
+        broken = good[name].copy()
+        broken[-1] = -math.inf
+        with pytest.raises(ValueError, match=f"{name} must be finite"):
+            row.regrid(**{**good, name: broken})
     assert row._const.tobytes() == before[0].tobytes() and row._state.tobytes() == before[1].tobytes()
     # The regridded row is independent of its source: stepping it leaves the source alone.
     other = row.regrid(**good)

@@ -1763,11 +1763,24 @@ def _block_extremes(gf, gmin, gmax):
         gmax[b] = most
 
 
+#: The arrays `Row.regrid` checks, in `_fill_regrid`'s order.
+_REGRID_ARRAYS = ("g_c", "gf", "gint", "wl", "wb")
+
+
 @numba.njit(cache=True, nogil=True)
 def _fill_regrid(const, state, chain_from, g_c, gf, gint, wl, wb, dx, df, e0, c_crit, reach, kap):
     """`Row.regrid`'s buffers: ``const`` (header, geometry, block extremes, the chain copied
     from the end of ``chain_from``) and ``state`` (zeros on entry: the memory, the coefficient
-    workspace holding no substep) in the order of `_const_layout` and `_state_layout`."""
+    workspace holding no substep) in the order of `_const_layout` and `_state_layout`, the
+    memory's sums for K <= 1 (K > 1: the caller sums with numpy). Returns the index in
+    `_REGRID_ARRAYS` of the first array that is not finite (buffers partly written), else -1."""
+    for index, values in enumerate((g_c, gf, gint)):
+        if not _all_finite(values):
+            return index
+    if not _all_finite(wl.reshape(wl.size)):
+        return 3
+    if not _all_finite(wb.reshape(wb.size)):
+        return 4
     n, k = wl.shape
     m = gf.shape[0]
     blocks = (m + TOUCH_BLOCK - 1) // TOUCH_BLOCK
@@ -1797,7 +1810,17 @@ def _fill_regrid(const, state, chain_from, g_c, gf, gint, wl, wb, dx, df, e0, c_
     state[0:size] = wl.reshape(size)
     at = size + n
     state[at : at + size] = wb.reshape(size)
+    if k == 1:
+        # numpy's wl.sum(axis=1) over one column: 0.0 + w (a -0.0 becomes +0.0).
+        for i in range(n):
+            total = 0.0
+            total += wl[i, 0]
+            state[size + i] = total
+            total_b = 0.0
+            total_b += wb[i, 0]
+            state[2 * size + n + i] = total_b
     state[state.shape[0] - COEF_ROWS * max(k, 1) + _C_SUBSTEP * max(k, 1)] = np.nan
+    return -1
 
 
 # ----------------------------------------------------------------------------------------
@@ -2162,14 +2185,14 @@ class Row:
             raise ValueError(f"reach must be > 0 (got {reach!r})")
         if wb is None:
             wb = np.zeros_like(wl)
-        for name, array, shape in (
-            ("g_c", g_c, (n,)),
-            ("gf", gf, (m,)),
-            ("gint", gint, (m,)),
-            ("wl", wl, (n, k)),
-            ("wb", wb, (n, k)),
+        arrays = (g_c, gf, gint, wl, wb)
+        for name, array, shape in zip(
+            _REGRID_ARRAYS, arrays, ((n,), (m,), (m,), (n, k), (n, k)), strict=True
         ):
-            _check(name, array, shape)
+            if not isinstance(array, np.ndarray) or array.dtype != np.float64:
+                raise TypeError(f"{name} must be a float64 numpy array")
+            if array.shape != shape:
+                raise ValueError(f"{name} must have shape {shape} (got {array.shape})")
         row = object.__new__(Row)
         row.dx, row.df, row.reach = float(dx), float(df), float(reach)
         row.e0, row.c_crit = self.e0, self.c_crit
@@ -2178,18 +2201,14 @@ class Row:
         blocks = (m + TOUCH_BLOCK - 1) // TOUCH_BLOCK
         row._const = np.empty(_arena_size(_const_layout(n, k, m, blocks), PACK_HEADER))
         row._state = np.zeros(_arena_size(_state_layout(n, k), 0))
-        # One compiled call fills both buffers (a growth builds this row inside a step, where
-        # each Python statement costs several microseconds); the views are bound on first
-        # use (`__getattr__`). The sums of the memory stay numpy's (its summation order).
-        _fill_regrid(
+        # One compiled call checks the arrays are finite and fills both buffers (a growth
+        # builds this row inside a step, where each Python statement costs microseconds);
+        # the views are bound on first use (`__getattr__`).
+        bad = _fill_regrid(
             row._const,
             row._state,
             self._const,
-            g_c,
-            gf,
-            gint,
-            np.ascontiguousarray(wl),
-            np.ascontiguousarray(wb),
+            *(np.ascontiguousarray(array) for array in arrays),
             row.dx,
             row.df,
             row.e0,
@@ -2197,8 +2216,12 @@ class Row:
             row.reach,
             row.kap,
         )
-        np.sum(row.wl, axis=1, out=row.wsum)
-        np.sum(row.wb, axis=1, out=row.bsum)
+        if bad >= 0:
+            raise ValueError(f"{_REGRID_ARRAYS[bad]} must be finite")
+        if k > 1:
+            # numpy's own summation order (the compiled fill sums K <= 1 as numpy does).
+            np.sum(row.wl, axis=1, out=row.wsum)
+            np.sum(row.wb, axis=1, out=row.bsum)
         row._kernel_args = None
         return row
 
