@@ -1917,12 +1917,21 @@ def _slots(
     return tuple(slots)
 
 
+#: The views `Row.regrid` binds at once (`Row.__getattr__` binds the others on first use).
+_EAGER_VIEWS = ("wl", "wsum", "wb", "bsum", "out")
+
+
 @functools.lru_cache(maxsize=256)
-def _slot_map(
-    start: int, layout: tuple[tuple[str, tuple[int, ...]], ...]
-) -> dict[str, tuple[int, int, tuple[int, ...]]]:
-    """`_slots` by name: (first, end, shape). Cached; never mutate the result."""
-    return {name: (first, end, shape) for name, first, end, shape in _slots(start, layout)}
+def _row_slots(n: int, k: int, m: int, blocks: int) -> dict[str, tuple[bool, int, int, tuple[int, ...]]]:
+    """Every view of a row by name: (in `_state`, first, end, shape). Cached; never mutate."""
+    slots = {
+        name: (False, first, end, shape)
+        for name, first, end, shape in _slots(PACK_HEADER, _const_layout(n, k, m, blocks))
+    }
+    slots.update(
+        {name: (True, first, end, shape) for name, first, end, shape in _slots(0, _state_layout(n, k))}
+    )
+    return slots
 
 
 def _views(buffer: np.ndarray, start: int, layout: tuple[tuple[str, tuple[int, ...]], ...]):
@@ -2218,6 +2227,13 @@ class Row:
         )
         if bad >= 0:
             raise ValueError(f"{_REGRID_ARRAYS[bad]} must be finite")
+        # The views a step reads at once (the memory, the output slots); the others on
+        # first use.
+        slots = row._slots = _row_slots(n, k, m, blocks)
+        state = row._state
+        for name in _EAGER_VIEWS:
+            _, first, end, shape = slots[name]
+            setattr(row, name, state[first:end].reshape(shape))
         if k > 1:
             # numpy's own summation order (the compiled fill sums K <= 1 as numpy does).
             np.sum(row.wl, axis=1, out=row.wsum)
@@ -2228,16 +2244,10 @@ class Row:
     def __getattr__(self, name: str) -> np.ndarray:
         """An array view not bound yet (`regrid` binds them on first use): bind it now."""
         fields = self.__dict__
-        if name in _VIEW_NAMES and "_const" in fields and "_state" in fields:
-            const = fields["_const"]
-            n, k, m, blocks = (int(v) for v in const[:4])
-            at = _slot_map(PACK_HEADER, _const_layout(n, k, m, blocks))
-            buffer = const
-            if name not in at:
-                at = _slot_map(0, _state_layout(n, k))
-                buffer = fields["_state"]
-            first, end, shape = at[name]
-            view = buffer[first:end].reshape(shape)
+        slots = fields.get("_slots")
+        if slots is not None and name in slots:
+            in_state, first, end, shape = slots[name]
+            view = fields["_state" if in_state else "_const"][first:end].reshape(shape)
             fields[name] = view
             return view
         raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
