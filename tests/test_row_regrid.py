@@ -207,3 +207,32 @@ def test_regrid_refuses_bad_input_and_changes_nothing() -> None:
     _kernels.advance(other, 0.0, 0.0, 5e-6, 1e-3, max_substep=0.0, max_edge_move=2.0 * row.dx)
     assert row._state.tobytes() == before[1].tobytes()
     assert not np.shares_memory(other._const, row._const)
+
+
+@pytest.mark.parametrize("indenter", list(INDENTERS))
+def test_growth_prepared_ahead_matches_the_reference(indenter: str) -> None:
+    """The next domain's geometry computed ahead in slices (`_prepare_growth`) gives the row
+    the 0.2.0 grower builds, byte for byte (the profile evaluated slice by slice equals it
+    evaluated whole); a half-prepared or stale preparation is not used."""
+    rng = np.random.default_rng(11)
+    for elements in (7, 160):
+        model = _model(indenter, "standard", elements)
+        for length in (1.7e-4, 1e-3):
+            row = model._build_row(length, rng.normal(scale=2e-6, size=(elements, 1)), None)
+            for slices in (0, 1, 3, 100):  # 0: nothing prepared; 3: half-prepared (N = 160)
+                model._prepared = None
+                for _ in range(slices):
+                    model._prepare_growth(row)
+                if slices == 100:
+                    assert model._prepared is not None and model._prepared[4] is not None
+                    assert model._prepared[0] == row.length * model.numerics.growth_factor
+                model.row, model.radius = row, 0.61 * row.length
+                expected = _reference_grow(model, row, model.radius)
+                model._grow(0.0)
+                _assert_same(model.row, expected, f"{indenter} N={elements} L={length} slices={slices}")
+            # A preparation for another length is not used.
+            other = model._build_row(0.5 * length, np.zeros((elements, 1)), None)
+            model.row, model.radius = other, 0.2 * other.length
+            expected = _reference_grow(model, other, model.radius)
+            model._grow(0.0)
+            _assert_same(model.row, expected, f"{indenter} stale preparation")
