@@ -219,7 +219,7 @@ def test_growth_prepared_ahead_matches_the_reference(indenter: str) -> None:
         model = _model(indenter, "standard", elements)
         for length in (1.7e-4, 1e-3):
             row = model._build_row(length, rng.normal(scale=2e-6, size=(elements, 1)), None)
-            for slices in (0, 1, 3, 100):  # 0: nothing prepared; 3: half-prepared (N = 160)
+            for slices in (0, 1, 3, 100):  # 0: nothing prepared; 1, 3: partly prepared (N = 160)
                 model._prepared = None
                 for _ in range(slices):
                     model._prepare_growth(row)

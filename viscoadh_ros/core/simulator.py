@@ -380,7 +380,7 @@ class _ClosedForm:
 #: A contact radius beyond this fraction of the domain starts computing the next domain's
 #: geometry ahead, one slice of `PREPARE_POINTS` fine points per step (`_prepare_growth`).
 PREPARE_FRACTION = 0.5
-PREPARE_POINTS = 1024
+PREPARE_POINTS = 4096
 
 
 class _TimeStepped:
