@@ -39,6 +39,7 @@ annulus gives up the surface energy ``2 pi x w dx = E0* c^2 x dx`` loses the dif
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numba
@@ -1743,6 +1744,85 @@ def _stored_energy(a, d, wl, wb, dx, g_c, gf, df, e0, e_kelvin):
     return total
 
 
+@numba.njit(cache=True, nogil=True)
+def _block_extremes(gf, gmin, gmax):
+    """Least and largest of each block of `TOUCH_BLOCK` points of ``gf`` (finite) into
+    ``gmin``/``gmax``: ``np.minimum.reduceat`` / ``np.maximum.reduceat`` over the block starts
+    (the extremes of finite values are exact; test_row_regrid pins them equal)."""
+    m = gf.shape[0]
+    for b in range(gmin.shape[0]):
+        j0 = b * TOUCH_BLOCK
+        j1 = min(j0 + TOUCH_BLOCK, m)
+        least = gf[j0]
+        most = gf[j0]
+        for j in range(j0 + 1, j1):
+            v = gf[j]
+            least = min(least, v)
+            most = max(most, v)
+        gmin[b] = least
+        gmax[b] = most
+
+
+#: The arrays `Row.regrid` checks, in `_fill_regrid`'s order.
+_REGRID_ARRAYS = ("g_c", "gf", "gint", "wl", "wb")
+
+
+@numba.njit(cache=True, nogil=True)
+def _fill_regrid(const, state, chain_from, g_c, gf, gint, wl, wb, dx, df, e0, c_crit, reach, kap):
+    """`Row.regrid`'s buffers: ``const`` (header, geometry, block extremes, the chain copied
+    from the end of ``chain_from``) and ``state`` (zeros on entry: the memory, the coefficient
+    workspace holding no substep) in the order of `_const_layout` and `_state_layout`, the
+    memory's sums for K <= 1 (K > 1: the caller sums with numpy). Returns the index in
+    `_REGRID_ARRAYS` of the first array that is not finite (buffers partly written), else -1."""
+    for index, values in enumerate((g_c, gf, gint)):
+        if not _all_finite(values):
+            return index
+    if not _all_finite(wl.reshape(wl.size)):
+        return 3
+    if not _all_finite(wb.reshape(wb.size)):
+        return 4
+    n, k = wl.shape
+    m = gf.shape[0]
+    blocks = (m + TOUCH_BLOCK - 1) // TOUCH_BLOCK
+    const[0] = n
+    const[1] = k
+    const[2] = m
+    const[3] = blocks
+    const[4] = dx
+    const[5] = df
+    const[6] = e0
+    const[7] = c_crit
+    const[8] = reach
+    const[9] = kap
+    at = PACK_HEADER
+    const[at : at + n] = g_c
+    at += n
+    const[at : at + m] = gf
+    at += m
+    const[at : at + m] = gint
+    at += m
+    _block_extremes(gf, const[at : at + blocks], const[at + blocks : at + 2 * blocks])
+    at += 2 * blocks
+    chain = 2 * k * k + 4 * k
+    const[at : at + chain] = chain_from[chain_from.shape[0] - chain :]
+    # state: wl, wsum, wb, bsum, scratch, scratch_b, diss, out, txn, txn_b, coef
+    size = n * k
+    state[0:size] = wl.reshape(size)
+    at = size + n
+    state[at : at + size] = wb.reshape(size)
+    if k == 1:
+        # numpy's wl.sum(axis=1) over one column: 0.0 + w (a -0.0 becomes +0.0).
+        for i in range(n):
+            total = 0.0
+            total += wl[i, 0]
+            state[size + i] = total
+            total_b = 0.0
+            total_b += wb[i, 0]
+            state[2 * size + n + i] = total_b
+    state[state.shape[0] - COEF_ROWS * max(k, 1) + _C_SUBSTEP * max(k, 1)] = np.nan
+    return -1
+
+
 # ----------------------------------------------------------------------------------------
 # Public wrappers: validate, then call the compiled kernel.
 
@@ -1778,6 +1858,7 @@ def _check_scalars(**values: float) -> None:
 PACK_HEADER = 10
 
 
+@functools.lru_cache(maxsize=256)
 def _state_layout(n: int, k: int) -> tuple[tuple[str, tuple[int, ...]], ...]:
     """The arrays in `Row._state`, in order, with their shapes (`_unpack` mirrors it)."""
     return (
@@ -1796,6 +1877,7 @@ def _state_layout(n: int, k: int) -> tuple[tuple[str, tuple[int, ...]], ...]:
     )
 
 
+@functools.lru_cache(maxsize=256)
 def _const_layout(n: int, k: int, m: int, blocks: int) -> tuple[tuple[str, tuple[int, ...]], ...]:
     """The arrays in `Row._const` after the header, in order (`_unpack` mirrors it)."""
     return (
@@ -1820,13 +1902,42 @@ def _arena_size(layout: tuple[tuple[str, tuple[int, ...]], ...], start: int) -> 
     return start + sum(math.prod(shape) for _, shape in layout)
 
 
-def _views(buffer: np.ndarray, start: int, layout: tuple[tuple[str, tuple[int, ...]], ...]):
-    """(name, view) of each array of `layout` in `buffer` from `start` on."""
+@functools.lru_cache(maxsize=256)
+def _slots(
+    start: int, layout: tuple[tuple[str, tuple[int, ...]], ...]
+) -> tuple[tuple[str, int, int, tuple[int, ...]], ...]:
+    """(name, first, end, shape) of each array of `layout` from `start` on (cached: a domain
+    growth rebinds two dozen views and the layout of a row size repeats)."""
+    slots = []
     offset = start
     for name, shape in layout:
         size = math.prod(shape)
-        yield name, buffer[offset : offset + size].reshape(shape)
+        slots.append((name, offset, offset + size, shape))
         offset += size
+    return tuple(slots)
+
+
+#: The views `Row.regrid` binds at once (`Row.__getattr__` binds the others on first use).
+_EAGER_VIEWS = ("wl", "wsum", "wb", "bsum", "out")
+
+
+@functools.lru_cache(maxsize=256)
+def _row_slots(n: int, k: int, m: int, blocks: int) -> dict[str, tuple[bool, int, int, tuple[int, ...]]]:
+    """Every view of a row by name: (in `_state`, first, end, shape). Cached; never mutate."""
+    slots = {
+        name: (False, first, end, shape)
+        for name, first, end, shape in _slots(PACK_HEADER, _const_layout(n, k, m, blocks))
+    }
+    slots.update(
+        {name: (True, first, end, shape) for name, first, end, shape in _slots(0, _state_layout(n, k))}
+    )
+    return slots
+
+
+def _views(buffer: np.ndarray, start: int, layout: tuple[tuple[str, tuple[int, ...]], ...]):
+    """(name, view) of each array of `layout` in `buffer` from `start` on."""
+    for name, first, end, shape in _slots(start, layout):
+        yield name, buffer[first:end].reshape(shape)
 
 
 @intrinsic
@@ -2052,6 +2163,94 @@ class Row:
         # `txn`, `txn_b`: the simulator's transaction journal, the memory before a step's first
         # kernel call; `scratch`, `scratch_b`, `diss`, `out`: the kernel's work and output slots.
         self._kernel_args: tuple | None = None
+
+    def regrid(
+        self,
+        *,
+        dx: float,
+        g_c: np.ndarray,
+        gf: np.ndarray,
+        gint: np.ndarray,
+        df: float,
+        reach: float,
+        wl: np.ndarray,
+        wb: np.ndarray | None = None,
+    ) -> Row:
+        """A new row of this row's chain and constants (``p`` .. ``e_kelvin``, ``steady``,
+        ``e0``, ``c_crit``: copied, already checked) on a new grid: the arguments as for
+        `Row` (``wl`` keeps this row's Kelvin count). The same buffers, bit for bit, as
+        `Row` given this row's chain; cheaper (a domain growth builds one inside a step):
+        the chain is copied as one block and not checked again, the block extremes of the
+        fine profile are one compiled pass."""
+        k = self.wl.shape[1]
+        if wl.ndim != 2 or wl.shape[1] != k:
+            raise ValueError(f"wl must have shape (N, {k}) (got {getattr(wl, 'shape', None)})")
+        n = wl.shape[0]
+        m = gf.shape[0]
+        _check_scalars(dx=dx, df=df)
+        if dx <= 0.0 or df <= 0.0 or m < 2 or n < 1:
+            raise ValueError("row needs dx > 0, df > 0, at least 1 element and 2 fine points")
+        if not reach > 0.0:
+            raise ValueError(f"reach must be > 0 (got {reach!r})")
+        if wb is None:
+            wb = np.zeros_like(wl)
+        arrays = (g_c, gf, gint, wl, wb)
+        for name, array, shape in zip(
+            _REGRID_ARRAYS, arrays, ((n,), (m,), (m,), (n, k), (n, k)), strict=True
+        ):
+            if not isinstance(array, np.ndarray) or array.dtype != np.float64:
+                raise TypeError(f"{name} must be a float64 numpy array")
+            if array.shape != shape:
+                raise ValueError(f"{name} must have shape {shape} (got {array.shape})")
+        row = object.__new__(Row)
+        row.dx, row.df, row.reach = float(dx), float(df), float(reach)
+        row.e0, row.c_crit = self.e0, self.c_crit
+        row.steady = self.steady
+        row.kap = self.kap
+        blocks = (m + TOUCH_BLOCK - 1) // TOUCH_BLOCK
+        row._const = np.empty(_arena_size(_const_layout(n, k, m, blocks), PACK_HEADER))
+        row._state = np.zeros(_arena_size(_state_layout(n, k), 0))
+        # One compiled call checks the arrays are finite and fills both buffers (a growth
+        # builds this row inside a step, where each Python statement costs microseconds);
+        # the views are bound on first use (`__getattr__`).
+        bad = _fill_regrid(
+            row._const,
+            row._state,
+            self._const,
+            *(np.ascontiguousarray(array) for array in arrays),
+            row.dx,
+            row.df,
+            row.e0,
+            row.c_crit,
+            row.reach,
+            row.kap,
+        )
+        if bad >= 0:
+            raise ValueError(f"{_REGRID_ARRAYS[bad]} must be finite")
+        # The views a step reads at once (the memory, the output slots); the others on
+        # first use.
+        slots = row._slots = _row_slots(n, k, m, blocks)
+        state = row._state
+        for name in _EAGER_VIEWS:
+            _, first, end, shape = slots[name]
+            setattr(row, name, state[first:end].reshape(shape))
+        if k > 1:
+            # numpy's own summation order (the compiled fill sums K <= 1 as numpy does).
+            np.sum(row.wl, axis=1, out=row.wsum)
+            np.sum(row.wb, axis=1, out=row.bsum)
+        row._kernel_args = None
+        return row
+
+    def __getattr__(self, name: str) -> np.ndarray:
+        """An array view not bound yet (`regrid` binds them on first use): bind it now."""
+        fields = self.__dict__
+        slots = fields.get("_slots")
+        if slots is not None and name in slots:
+            in_state, first, end, shape = slots[name]
+            view = fields["_state" if in_state else "_const"][first:end].reshape(shape)
+            fields[name] = view
+            return view
+        raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
 
     def _attach_views(self) -> None:
         """(Re)bind the array attributes to their places in `_const` and `_state`."""
@@ -2323,6 +2522,15 @@ def warm_up() -> None:
         steady=0.5 * one,
         e0=1.0,
         c_crit=0.1,
+    )
+    row.regrid(
+        dx=0.25,
+        g_c=row.g_c.copy(),
+        gf=row.gf.copy(),
+        gint=row.gint.copy(),
+        df=row.df,
+        reach=row.reach,
+        wl=np.zeros((n, k)),
     )
     advance(row, 0.0, 0.0, 0.1, 0.01, max_substep=0.0, max_edge_move=0.25)
     advance(row, 0.3, 0.1, 0.2, 0.0, max_substep=0.0, max_edge_move=0.25)

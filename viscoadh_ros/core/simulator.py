@@ -377,6 +377,12 @@ class _ClosedForm:
         self.radius = 0.0
 
 
+#: A contact radius beyond this fraction of the domain starts computing the next domain's
+#: geometry ahead, one slice of `PREPARE_POINTS` fine points per step (`_prepare_growth`).
+PREPARE_FRACTION = 0.5
+PREPARE_POINTS = 4096
+
+
 class _TimeStepped:
     """The 1D MDR row of creep elements (see `_kernels`)."""
 
@@ -411,6 +417,20 @@ class _TimeStepped:
         # The first contact's domain, built once here (about 0.1 ms: the fine profile grid and
         # its checks) rather than inside the snap-in step; each new contact takes a copy of
         # it with zero memory.
+        # Index arrays of the centre and fine grids (their coordinates are these times the
+        # spacing, as np.arange and np.linspace compute them), and the first row built: later
+        # rows take its chain (`Row.regrid`).
+        n = numerics.elements
+        self._centre_index = np.arange(n) + 0.5
+        self._fine_index = np.arange(0, n * numerics.fine_factor + 1, dtype=np.float64)
+        self._chain_row: _kernels.Row | None = None
+        # The next domain's geometry being computed ahead (`_prepare_growth`): [length,
+        # fine points done, gf, gint, centre profile or None].
+        self._prepared: list | None = None
+        # The row `advance` last checked and the contact radius beyond which it prepares
+        # (inf once the preparation for that row is complete or impossible).
+        self._prepare_row: _kernels.Row | None = None
+        self._prepare_radius = math.inf
         self._template: _kernels.Row | None = None
         if self.initial_length > 0.0:
             self._template = self._build_row(self.initial_length, None)
@@ -431,8 +451,16 @@ class _TimeStepped:
 
     # -- the domain ---------------------------------------------------------------------
     def _build_row(
-        self, length: float, memory: np.ndarray | None, unit: np.ndarray | None = None
+        self,
+        length: float,
+        memory: np.ndarray | None,
+        unit: np.ndarray | None = None,
+        centre_profile: np.ndarray | None = None,
+        fine_profile: tuple[np.ndarray, np.ndarray, float] | None = None,
     ) -> _kernels.Row:
+        """The row over (0, length] (capped at the reach) with Kelvin state `memory`, `unit`
+        (None: zeros) and, if the caller has them, the profile at its centres and
+        (`_prepare_growth`) on its fine grid with the integral and the fine spacing."""
         n = self.numerics.elements
         m = n * self.numerics.fine_factor + 1
         profile = self.physics.profile
@@ -441,16 +469,35 @@ class _TimeStepped:
             reach = self.punch_radius
             length = min(length, reach)
         dx = length / n
-        centres = (np.arange(n) + 0.5) * dx
-        fine = np.linspace(0.0, length, m)
+        if centre_profile is None:
+            centre_profile = np.asarray(profile.g(self._centre_index * dx), dtype=np.float64)
         k = self.e_kelvin.size
         wl = np.zeros((n, k)) if memory is None else memory
-        return _kernels.Row(
+        if fine_profile is not None:
+            gf, gint, df = fine_profile
+        else:
+            # np.linspace(0, length, m) by its own arithmetic (index times the step, the end
+            # point set exactly) on the cached index: the same array, without its overhead.
+            step = length / (m - 1)
+            if step > 0.0:
+                fine = self._fine_index * step
+                fine[-1] = length
+            else:
+                fine = np.linspace(0.0, length, m)
+            gf = np.asarray(profile.g(fine), dtype=np.float64)
+            gint = np.asarray(profile.g_integral(fine), dtype=np.float64)
+            df = fine[1]
+        chain = self._chain_row
+        if chain is not None:
+            return chain.regrid(
+                dx=dx, g_c=centre_profile, gf=gf, gint=gint, df=df, reach=reach, wl=wl, wb=unit
+            )
+        row = _kernels.Row(
             dx=dx,
-            g_c=np.asarray(profile.g(centres), dtype=np.float64),
-            gf=np.asarray(profile.g(fine), dtype=np.float64),
-            gint=np.asarray(profile.g_integral(fine), dtype=np.float64),
-            df=fine[1],
+            g_c=centre_profile,
+            gf=gf,
+            gint=gint,
+            df=df,
             reach=reach,
             wl=wl,
             p=self.p,
@@ -464,6 +511,49 @@ class _TimeStepped:
             c_crit=self.physics.c_crit,
             wb=unit,
         )
+        self._chain_row = row
+        return row
+
+    def _prepare_growth(self, row: _kernels.Row) -> None:
+        """One slice of the next domain's geometry (length L x growth_factor: its fine
+        profile and integral, then its centre profile), so that a growth, when it comes,
+        does not evaluate the profile inside its step. The same values as `_build_row`
+        computes (the profile is elementwise: a slice of the grid gives the slice of its
+        values; tests/test_row_regrid.py); a pure function of the length, so not part of
+        the state (transactions and snapshots ignore it)."""
+        length = row.length * self.numerics.growth_factor
+        prepared = self._prepared
+        if prepared is None or prepared[0] != length:
+            if length > max(1e6 * self.initial_length, 1e3):
+                self._prepare_radius = math.inf
+                return
+            m = self._fine_index.shape[0]
+            self._prepared = [length, 0, np.empty(m), np.empty(m), None]
+            return
+        filled, gf, gint = prepared[1], prepared[2], prepared[3]
+        if prepared[4] is not None:
+            self._prepare_radius = math.inf
+            return
+        reach = self.punch_radius if self.punch_radius is not None else math.inf
+        span = min(length, reach)
+        m = gf.shape[0]
+        step = span / (m - 1)
+        if not step > 0.0:
+            self._prepare_radius = math.inf
+            return
+        profile = self.physics.profile
+        if filled < m:
+            end = min(filled + PREPARE_POINTS, m)
+            fine = self._fine_index[filled:end] * step
+            if end == m:
+                fine[-1] = span
+            gf[filled:end] = np.asarray(profile.g(fine), dtype=np.float64)
+            gint[filled:end] = np.asarray(profile.g_integral(fine), dtype=np.float64)
+            prepared[1] = end
+            return
+        dx = span / self.numerics.elements
+        prepared[4] = np.asarray(profile.g(self._centre_index * dx), dtype=np.float64)
+        self._prepare_radius = math.inf
 
     def _grow(self, depth: float) -> None:
         """Grow the domain, remapping the memory side by side of the edge (`remap_memory`)
@@ -475,10 +565,21 @@ class _TimeStepped:
         if length > limit:
             raise InputError(self._unrepresentable(limit))
         reach = self.punch_radius if self.punch_radius is not None else math.inf
-        dx = min(length, reach) / row.elements
-        centres = np.asarray(self.physics.profile.g((np.arange(row.elements) + 0.5) * dx), dtype=np.float64)
-        memory, unit = _kernels.remap_memory(row, self.radius, row.elements, min(length, reach), centres)
-        self.row = self._build_row(length, memory, unit)
+        span = min(length, reach)
+        dx = span / row.elements
+        prepared = self._prepared
+        fine_profile = None
+        if prepared is not None and prepared[0] == length and prepared[4] is not None:
+            centres = prepared[4]
+            fine_profile = (prepared[2], prepared[3], span / (prepared[2].shape[0] - 1))
+        else:
+            centres = np.asarray(self.physics.profile.g(self._centre_index * dx), dtype=np.float64)
+        # `remap_memory` without its checks: the radius and span are this model's own, the
+        # centre profile is checked by the new row.
+        memory = np.empty_like(row.wl)
+        unit = np.empty_like(row.wl)
+        _kernels._remap(row.wl, row.wb, float(self.radius), row.dx, row.g_c, dx, centres, memory, unit)
+        self.row = self._build_row(length, memory, unit, centres, fine_profile)
 
     def _unrepresentable(self, limit: float) -> str:
         """Why a contact that needs a domain longer than ``limit`` (m) cannot be stepped."""
@@ -554,6 +655,11 @@ class _TimeStepped:
         self._memory_peak = peak
         self._edge = (outside, inside, g_edge)
         self._edge_depth = d1
+        if row is not self._prepare_row:
+            self._prepare_row = row
+            self._prepare_radius = PREPARE_FRACTION * row.length
+        if radius > self._prepare_radius:
+            self._prepare_growth(row)
         return radius, force, work
 
     def advance_rows(
