@@ -255,6 +255,12 @@ _ROOT_SLACK = 3
 
 @numba.njit(cache=True, nogil=True)
 def _bisect(x_lo, x_hi, d, wsum, bsum, lo, hi, dx, g_c, gf, df, c_crit):
+    """`_edge_root` without the end values (it evaluates h there)."""
+    return _edge_root(x_lo, x_hi, math.nan, math.nan, d, wsum, bsum, lo, hi, dx, g_c, gf, df, c_crit)
+
+
+@numba.njit(cache=True, nogil=True)
+def _edge_root(x_lo, x_hi, f_lo, f_hi, d, wsum, bsum, lo, hi, dx, g_c, gf, df, c_crit):
     """Root of h between x_lo (h >= 0) and x_hi (h < 0), to ``EDGE_TOLERANCE * dx``: far
     below the discretisation error. Returns the midpoint of a bracket no wider than the
     tolerance whose left end has h >= 0 and right end h < 0, as plain bisection did.
@@ -269,13 +275,20 @@ def _bisect(x_lo, x_hi, d, wsum, bsum, lo, hi, dx, g_c, gf, df, c_crit):
     beyond bisection's count), and kept at least ``0.45 tol`` inside the bracket, so a
     secant that has converged to one side closes the bracket with its next step. If the
     end values do not have the signs the caller promised (rounding), plain bisection.
+
+    ``f_lo``/``f_hi`` are h at the ends when the caller has them (NaN: evaluated here; the
+    same numbers either way, one or two evaluations fewer).
     """
     tol = EDGE_TOLERANCE * dx
     a = x_lo
     b = x_hi
     if b - a > tol:
-        fa = _h(a, d, wsum, bsum, lo, hi, dx, g_c, gf, df, c_crit)
-        fb = _h(b, d, wsum, bsum, lo, hi, dx, g_c, gf, df, c_crit)
+        fa = f_lo
+        if math.isnan(fa):
+            fa = _h(a, d, wsum, bsum, lo, hi, dx, g_c, gf, df, c_crit)
+        fb = f_hi
+        if math.isnan(fb):
+            fb = _h(b, d, wsum, bsum, lo, hi, dx, g_c, gf, df, c_crit)
         if fa >= 0.0 and fb < 0.0:
             n_half = int(math.ceil(math.log2((b - a) / tol)))
             budget = 0.5 * tol * 2.0 ** (n_half + _ROOT_SLACK)
@@ -392,6 +405,7 @@ def _scan_out(x_start, d, wsum, bsum, lo, hi, dx, g_c, gf, gmin, gmax, df, c_cri
     m = gf.shape[0]
     j = int(x_start / df) + 1
     prev = x_start
+    h_prev = math.nan  # h at prev when known (the root finder's end value)
     while j < m:
         if prev > x_stop:
             return prev, False
@@ -402,18 +416,23 @@ def _scan_out(x_start, d, wsum, bsum, lo, hi, dx, g_c, gf, gmin, gmax, df, c_cri
                 lower, _ = _h_bounds(b, d, wsum, bsum, lo, hi, dx, g_c, gf, gmin, gmax, df, c_crit)
                 if lower >= 0.0:
                     prev = j_end * df
+                    h_prev = math.nan
                     j = j_end + 1
                     continue
         xj = j * df
         # A domain that ends at the reach (flat punch: L = a0) must not ask to grow
         # because the last fine point fell a rounding error short of it.
         if xj >= reach * (1.0 - 1e-12):
-            if _h(reach, d, wsum, bsum, lo, hi, dx, g_c, gf, df, c_crit) >= 0.0:
+            h_reach = _h(reach, d, wsum, bsum, lo, hi, dx, g_c, gf, df, c_crit)
+            if h_reach >= 0.0:
                 return reach, False
-            return _bisect(prev, reach, d, wsum, bsum, lo, hi, dx, g_c, gf, df, c_crit), False
-        if _h(xj, d, wsum, bsum, lo, hi, dx, g_c, gf, df, c_crit) < 0.0:
-            return _bisect(prev, xj, d, wsum, bsum, lo, hi, dx, g_c, gf, df, c_crit), False
+            root = _edge_root(prev, reach, h_prev, h_reach, d, wsum, bsum, lo, hi, dx, g_c, gf, df, c_crit)
+            return root, False
+        h_j = _h(xj, d, wsum, bsum, lo, hi, dx, g_c, gf, df, c_crit)
+        if h_j < 0.0:
+            return _edge_root(prev, xj, h_prev, h_j, d, wsum, bsum, lo, hi, dx, g_c, gf, df, c_crit), False
         prev = xj
+        h_prev = h_j
         j += 1
     return prev, True
 
@@ -565,7 +584,8 @@ def _locate_edge(a, d, wsum, bsum, dx, g_c, gf, gmin, gmax, df, c_crit, reach, m
     # first: an over-stretched interior edge cannot hold, whatever the memory outside says.
     # (Elements that just let go sit at the attachment threshold; the other order lets the
     # discretised exterior memory re-attach them and the receding edge chatter.)
-    if _h(a, d, wsum, bsum, 0, n_in - 1, dx, g_c, gf, df, c_crit) < 0.0:
+    h_upper = _h(a, d, wsum, bsum, 0, n_in - 1, dx, g_c, gf, df, c_crit)
+    if h_upper < 0.0:
         # Inward, the first fine point where h >= 0; whole blocks whose upper bound of h is
         # below 0 (`_h_bounds`) are stepped over (the same point as point by point).
         j = int(a / df)
@@ -580,13 +600,16 @@ def _locate_edge(a, d, wsum, bsum, dx, g_c, gf, gmin, gmax, df, c_crit, reach, m
                 _, top = _h_bounds(b, d, wsum, bsum, 0, n_in - 1, dx, g_c, gf, gmin, gmax, df, c_crit)
                 if top < 0.0:
                     upper = b * TOUCH_BLOCK * df
+                    h_upper = math.nan
                     j = b * TOUCH_BLOCK - 1
                     continue
             xj = j * df
-            if _h(xj, d, wsum, bsum, 0, n_in - 1, dx, g_c, gf, df, c_crit) >= 0.0:
-                radius = _bisect(xj, upper, d, wsum, bsum, 0, n_in - 1, dx, g_c, gf, df, c_crit)
-                return radius, MOTION_DETACH, False
+            h_j = _h(xj, d, wsum, bsum, 0, n_in - 1, dx, g_c, gf, df, c_crit)
+            if h_j >= 0.0:
+                args = (d, wsum, bsum, 0, n_in - 1, dx, g_c, gf, df, c_crit)
+                return _edge_root(xj, upper, h_j, h_upper, *args), MOTION_DETACH, False
             upper = xj
+            h_upper = h_j
             j -= 1
         return 0.0, MOTION_DETACH, False
     # Attachment of exterior elements, judged with the exterior (residual) memory.
