@@ -391,7 +391,7 @@ def _h_bounds(b, d, wsum, bsum, lo, hi, dx, g_c, gf, gmin, gmax, df, c_crit):
 @numba.njit(cache=True, nogil=True)
 def _scan_out(x_start, d, wsum, bsum, lo, hi, dx, g_c, gf, gmin, gmax, df, c_crit, reach, x_stop):
     """Outermost point of the h >= 0 run that starts at x_start (exterior memory): the
-    first fine point beyond x_start where h < 0, bisected against the point before.
+    first fine point beyond x_start where h < 0, its root against the point before (`_edge_root`).
 
     Whole blocks of `TOUCH_BLOCK` fine points whose lower bound of h (`_h_bounds`) is >= 0
     are stepped over: the same point as a point-by-point scan, found in O(blocks + points
