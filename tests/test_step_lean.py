@@ -3,7 +3,9 @@
 `step_scenarios` records varied sequences (snap-in, pull-off, out of contact with memory,
 depth jumps at one time, domain growth, refused calls mid-way, reset, snapshot/restore into the
 same and another simulator, `advance`, `step_depths`); the golden was written from main at
-fecbb5f before the lean step path and the packed kernel call.
+fecbb5f before the lean step path and the packed kernel call. Since the 0.3.0 edge root finder
+moved edges by up to 1e-12 of an element, the golden comparison allows `golden_tolerance`'s
+tolerance where the bits differ (the twins below stay bit for bit).
 """
 
 from __future__ import annotations
@@ -15,22 +17,34 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from golden_tolerance import column_failures
 from scenes import one_contact
 from step_scenarios import depth_scale, run_scene, scenes
 
 from viscoadh_ros.core import _kernels, simulator
-from viscoadh_ros.core.simulator import ContactSimulator
+from viscoadh_ros.core.simulator import STEP_OUTPUT_FIELDS, ContactSimulator
 
 GOLDEN = Path(__file__).resolve().parent / "data" / "step_golden.npz"
 
 
 @pytest.mark.parametrize("name", sorted(scenes()))
 def test_step_path_is_bit_equal_to_the_golden(name: str) -> None:
+    """Bit for bit, or, since the 0.3.0 edge root finder (`edge`: a safeguarded secant in
+    place of bisection, same tolerance, edges moved by up to 1e-12 of an element), within
+    `golden_tolerance`'s tolerance on every output field; the memory digest (a hash of its
+    bits) is then not compared: the memory is pinned within that tolerance by
+    tests/test_kernel_golden.py, and the step path's handling of it (undo, snapshot, restore)
+    bit for bit by the in-process twins below."""
     expected = np.load(GOLDEN)[name]
     got = run_scene(scenes()[name], depth_scale(name))
     assert got.shape == expected.shape
     bad = np.flatnonzero(np.any(got.view(np.uint64) != expected.view(np.uint64), axis=1))
-    assert bad.size == 0, f"{name}: first differing row {bad[0]}: {got[bad[0]]} != {expected[bad[0]]}"
+    if bad.size == 0:
+        return
+    fields = expected[:, :-1], got[:, :-1]
+    phase, speed = STEP_OUTPUT_FIELDS.index("phase"), STEP_OUTPUT_FIELDS.index("edge_speed")
+    failures = column_failures(*fields, phase=phase, speed=speed)
+    assert not failures, f"{name}: first differing row {bad[0]}: {failures}"
 
 
 def _state(sim) -> tuple:
