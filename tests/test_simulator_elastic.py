@@ -235,3 +235,34 @@ def test_tabulated_sphere_follows_hertz_and_jkr() -> None:
             err_msg=f"table d={d}",
         )
     assert sim.output.effective_work_of_adhesion == pytest.approx(0.05, rel=1e-2)
+
+
+@pytest.mark.parametrize("elements", [64, 160])
+def test_an_edge_at_rest_keeps_one_phase_on_every_path(elements: int) -> None:
+    """A time-stepped elastic contact held at one depth is re-located every step and lands
+    within the edge tolerance (~1e-18 m here): it read INDENTING and DETACHING on alternate
+    steps (found in the 0.3.0 round). At rest it sits on the attachment condition: INDENTING,
+    on the lean step, the general step (a held force) and the batch path; a real press and a
+    real pull still read INDENTING and DETACHING (path: time_stepped)."""
+    contact = one_contact(
+        {"shape": "sphere", "radius": 0.01},
+        work=0.05,
+        numerics={"elements": elements, "model": "time_stepped"},
+    )
+    press = np.arange(1, 11) * 1e-6
+    times = np.arange(1, 61) * 1e-3
+    depths = np.concatenate([press, np.full(50, press[-1])])
+    lean = ContactSimulator(contact)
+    phases = [lean.step(float(t), depth=float(d)).phase for t, d in zip(times, depths, strict=True)]
+    assert all(p == Phase.INDENTING for p in phases), phases
+    assert lean.output.contact_radius > 0.0
+    batch = ContactSimulator(contact).step_depths(times, depths)
+    assert np.all(batch["phase"] == Phase.INDENTING), batch["phase"]
+    held = ContactSimulator(contact)
+    for t, d in zip(times[:10], press, strict=True):
+        held.step(float(t), depth=float(d))
+    force = held.output.force
+    held_phases = [held.step(float(t), force=force).phase for t in times[10:20]]
+    assert all(p == Phase.INDENTING for p in held_phases), held_phases
+    pulled = lean.step(float(times[-1] + 0.01), depth=float(depths[-1] - 2e-6))
+    assert pulled.phase == Phase.DETACHING

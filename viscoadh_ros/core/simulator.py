@@ -353,6 +353,12 @@ class _ClosedForm:
         """Profile g at `radius`, m."""
         return float(self.physics.profile.g(radius))
 
+    @property
+    def edge_resolution(self) -> float:
+        """Radius change below which the edge counts as at rest, m: the closed form's radius
+        is exact, so any change is a motion."""
+        return 0.0
+
     def is_relaxed(self) -> bool:
         return True
 
@@ -751,6 +757,15 @@ class _TimeStepped:
             _kernels.criterion_gap(self.row, self.radius, depth, self.radius, interior=True),
         )
 
+    @property
+    def edge_resolution(self) -> float:
+        """Radius change below which the edge counts as at rest, m: twice the tolerance the
+        kernel locates an edge to (`_kernels.EDGE_TOLERANCE` of an element), since an edge at
+        rest is located again every step and lands anywhere within it (a pinned elastic
+        edge otherwise read INDENTING and DETACHING on alternate steps)."""
+        row = self.row
+        return 0.0 if row is None else 2.0 * _kernels.EDGE_TOLERANCE * row.dx
+
     def edge_height(self, radius: float) -> float:
         """Profile g at the edge `radius` (m), m, as the kernel sees it (fine grid)."""
         if radius == self.radius and self._edge_depth == self._edge_depth and radius > 0.0:
@@ -1079,9 +1094,10 @@ class ContactSimulator:
                         g_edge = 0.0
                     else:
                         outside, inside, g_edge = model._edge
-                        if radius > r0:
+                        rest = model.edge_resolution
+                        if radius > r0 + rest:
                             phase = _INDENTING
-                        elif radius < r0:
+                        elif radius < r0 - rest:
                             phase = _DETACHING
                         else:
                             tol = 1e-9 * (abs(d) + physics.c_crit * math.sqrt(radius) + g_edge)
@@ -1228,6 +1244,7 @@ class ContactSimulator:
             outputs = [self._step(float(ti), float(di), None) for ti, di in zip(t, d, strict=True)]
             return _columns(outputs)
         physics = self.physics
+        rest = self._model.edge_resolution  # the row after the batch (growth only widens it)
         r0 = np.concatenate(([self._output.contact_radius], radius[:-1]))
         dt = np.diff(t, prepend=self._time)
         energy_input = np.cumsum(np.concatenate(([self._energy_input], work)))[1:]
@@ -1239,7 +1256,9 @@ class ContactSimulator:
         phase = np.where(
             radius <= 0.0,
             Phase.NO_CONTACT,
-            np.where(radius > r0, Phase.INDENTING, np.where(radius < r0, Phase.DETACHING, pinned)),
+            np.where(
+                radius > r0 + rest, Phase.INDENTING, np.where(radius < r0 - rest, Phase.DETACHING, pinned)
+            ),
         ).astype(np.uint8)
         moving = dt > 0.0
         edge_speed = np.where(moving, (radius - r0) / np.where(moving, dt, 1.0), 0.0)
@@ -1305,11 +1324,12 @@ class ContactSimulator:
     ) -> StepOutput:
         physics = self.physics
         g_edge = self._model.edge_height(radius) if radius > 0.0 else 0.0
+        rest = self._model.edge_resolution
         if radius <= 0.0:
             phase = _NO_CONTACT
-        elif radius > r0:
+        elif radius > r0 + rest:
             phase = _INDENTING
-        elif radius < r0:
+        elif radius < r0 - rest:
             phase = _DETACHING
         else:
             # Pinned edge: say which criterion it rests on, if any (elastic contacts at
