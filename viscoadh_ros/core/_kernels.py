@@ -2131,6 +2131,12 @@ def _unpack(state, const):
     return args, txn, txn_b
 
 
+# Releases the GIL like every kernel, although one step takes microseconds. Keeping it was
+# tried (0.3.0 round): in-process (`python -m viscoadh_ros.bench.live_profile --contacts 4`,
+# logging on) the live thread's CPU per command fell 60 -> 34-41 us, but through DDS
+# (`viscoadh bench --sections node`, side by side within minutes) the node's p50 rose
+# 1.4-1.8 -> 3.3-3.6 ms and its drops 5-12k -> 25-29k: rclpy's own threads move while the
+# kernel runs. Decide threading changes on the DDS measurement, not the in-process profile.
 @numba.njit(cache=True, nogil=True)
 def _advance_packed(state, const, journal, a, d0, d1, dt, max_substep, max_edge_move):
     """`_advance` on the row whose buffers are `state` and `const` (`Row._state`,
