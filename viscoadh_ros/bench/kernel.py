@@ -164,14 +164,7 @@ def measure_kernel(elements: int, kelvin: int, *, steps: int, repeats: int) -> d
     wl0, wb0 = row.memory()
     d_start = simulator.output.depth
     # The minimal stepper on the product's own grid, from the product's own state.
-    minimal = MinimalStepper(
-        g_centres=row.g_c,
-        dx=row.dx,
-        e0=simulator.physics.e0,
-        e_kelvin=model.e_kelvin,
-        eta_kelvin=model.e_kelvin / model.rate if model.e_kelvin.size else np.zeros(0),
-        c_crit=simulator.physics.c_crit,
-    )
+    minimal = MinimalStepper.on_grid_of(simulator)
 
     max_substep = float(numerics.max_substep)
     max_edge_move = float(numerics.max_edge_cells * row.dx)

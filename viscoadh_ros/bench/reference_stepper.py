@@ -26,6 +26,7 @@ The algorithm (one contact, displacement control, depth linear in time over each
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numba
 import numpy as np
@@ -176,6 +177,21 @@ class MinimalStepper:
     shape (K,) (K = 0: elastic); c_crit: critical glass elongation per sqrt(m),
     ``dl_c(x) = c_crit sqrt(x)``.
     """
+
+    @classmethod
+    def on_grid_of(cls, simulator: Any) -> MinimalStepper:
+        """The minimal stepper on a time-stepped `ContactSimulator`'s current grid and chain (its
+        row must exist): the bench's side-by-side baseline (kernel and replay sections)."""
+        model = simulator._model  # the bench reads the product's private grid on purpose
+        row = model.row
+        return cls(
+            g_centres=row.g_c,
+            dx=row.dx,
+            e0=simulator.physics.e0,
+            e_kelvin=model.e_kelvin,
+            eta_kelvin=model.e_kelvin / model.rate if model.e_kelvin.size else np.zeros(0),
+            c_crit=simulator.physics.c_crit,
+        )
 
     def __init__(
         self,

@@ -153,17 +153,8 @@ def _minimal_run(contact: Any, times: Any, depths: Any) -> Any:
         raise RuntimeError("the replay bench's minimal stepper needs a fixed command period")
     simulator = ContactSimulator(contact)
     simulator.step(float(steps[0]), depth=max(float(np.max(depths)), 1e-9))
-    model = simulator._model  # the bench reads the product's grid, as the kernel section does
-    row = model.row
-    minimal = MinimalStepper(
-        g_centres=row.g_c,
-        dx=row.dx,
-        e0=simulator.physics.e0,
-        e_kelvin=model.e_kelvin,
-        eta_kelvin=model.e_kelvin / model.rate if model.e_kelvin.size else np.zeros(0),
-        c_crit=simulator.physics.c_crit,
-    )
-    memory = np.zeros_like(row.wl)
+    minimal = MinimalStepper.on_grid_of(simulator)
+    memory = np.zeros_like(simulator._model.row.wl)
     dt = float(steps[0])
 
     def run() -> None:
