@@ -849,6 +849,32 @@ class _TimeStepped:
         self._edge_depth = math.nan
 
 
+def _phase(model: Any, physics: _Physics, depth: float, r0: float, radius: float, g_edge: float) -> Phase:
+    """The phase of a step that moved the edge from `r0` to `radius` (m) at `depth` (m), g at
+    the new edge `g_edge` (m). The one rule for `step`'s lean and general paths
+    (`ContactSimulator.step_depths` applies the same rule to columns).
+
+    An edge that moved less than the model's `edge_resolution` is at rest (a time-stepped
+    edge is located again every step and lands anywhere within its tolerance); a pinned edge
+    says which criterion it rests on, if any (elastic contacts at rest sit on both; a punch
+    rim blocks attachment). The gaps are read only for a pinned edge (after a step the
+    time-stepped model returns the ones its kernel computed)."""
+    if radius <= 0.0:
+        return _NO_CONTACT
+    rest = model.edge_resolution
+    if radius > r0 + rest:
+        return _INDENTING
+    if radius < r0 - rest:
+        return _DETACHING
+    tol = 1e-9 * (abs(depth) + physics.c_crit * math.sqrt(radius) + g_edge)
+    outside, inside = model.edge_gaps(depth)
+    if outside >= -tol:
+        return _INDENTING
+    if inside <= tol:
+        return _DETACHING
+    return _STICKING
+
+
 def _bracketed_root(
     residual: Any, a: float, fa: float, b: float, fb: float, tol: float
 ) -> tuple[float, float]:
@@ -1089,24 +1115,8 @@ class ContactSimulator:
                     radius, f, work = model.advance(d_prev, d, dt)
                     energy = energy0 + work
                     physics = self.physics
-                    if radius <= 0.0:
-                        phase = _NO_CONTACT
-                        g_edge = 0.0
-                    else:
-                        outside, inside, g_edge = model._edge
-                        rest = model.edge_resolution
-                        if radius > r0 + rest:
-                            phase = _INDENTING
-                        elif radius < r0 - rest:
-                            phase = _DETACHING
-                        else:
-                            tol = 1e-9 * (abs(d) + physics.c_crit * math.sqrt(radius) + g_edge)
-                            if outside >= -tol:
-                                phase = _INDENTING
-                            elif inside <= tol:
-                                phase = _DETACHING
-                            else:
-                                phase = _STICKING
+                    g_edge = model._edge[2] if radius > 0.0 else 0.0
+                    phase = _phase(model, physics, d, r0, radius, g_edge)
                     edge_speed = (radius - r0) / dt if dt > 0.0 else 0.0
                     u = d - g_edge
                     if radius > 0.0 and u < 0.0:
@@ -1248,7 +1258,8 @@ class ContactSimulator:
         r0 = np.concatenate(([self._output.contact_radius], radius[:-1]))
         dt = np.diff(t, prepend=self._time)
         energy_input = np.cumsum(np.concatenate(([self._energy_input], work)))[1:]
-        g = gaps[:, 2]  # g at the edge as the kernel saw it (0 without contact), like `step`
+        # `_phase` on columns. g at the edge as the kernel saw it (0 without contact), like `step`.
+        g = gaps[:, 2]
         tol = 1e-9 * (np.abs(d) + physics.c_crit * np.sqrt(radius) + g)
         pinned = np.where(
             gaps[:, 0] >= -tol, Phase.INDENTING, np.where(gaps[:, 1] <= tol, Phase.DETACHING, Phase.STICKING)
@@ -1324,24 +1335,7 @@ class ContactSimulator:
     ) -> StepOutput:
         physics = self.physics
         g_edge = self._model.edge_height(radius) if radius > 0.0 else 0.0
-        rest = self._model.edge_resolution
-        if radius <= 0.0:
-            phase = _NO_CONTACT
-        elif radius > r0 + rest:
-            phase = _INDENTING
-        elif radius < r0 - rest:
-            phase = _DETACHING
-        else:
-            # Pinned edge: say which criterion it rests on, if any (elastic contacts at
-            # rest sit on both; a punch rim blocks attachment). `step`'s lean path repeats this.
-            tol = 1e-9 * (abs(depth) + physics.c_crit * math.sqrt(radius) + g_edge)
-            outside, inside = self._model.edge_gaps(depth)
-            if outside >= -tol:
-                phase = _INDENTING
-            elif inside <= tol:
-                phase = _DETACHING
-            else:
-                phase = _STICKING
+        phase = _phase(self._model, physics, depth, r0, radius, g_edge)
         edge_speed = (radius - r0) / dt if dt > 0.0 else 0.0
         dissipated = self._model.energy_dissipated(self._energy_input, depth)
         u = depth - g_edge
