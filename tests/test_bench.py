@@ -116,6 +116,57 @@ def test_minimal_stepper_agrees_with_the_product_on_a_pull_off() -> None:
     assert agreement["max_force_diff_rel"] < 0.05, agreement
 
 
+@pytest.mark.parametrize("kelvin", [0, 1, 2, 4])
+def test_minimal_stepper_is_the_plain_algorithm(kelvin: int) -> None:
+    """The fast baseline (modal matrices, mode-major loops, two buffers, prefix sums, fastmath
+    reassociation) computes what the plain element-by-element stepper computes, step for step:
+    a press from rest, a pull-off past the fold, a re-contact and a creeping hold on the
+    product's grid (radius and force; the force relative to the pull-off force)."""
+    from plain_minimal_stepper import PlainMinimalStepper
+
+    case = next(c for c in accuracy.cases() if c.name == "standard_solid_pull_off")
+    material = kernel.kelvin_material(case, kelvin)
+    contact = accuracy.contact_config(
+        accuracy.Case(case.name, dict(case.contact, material=material), case.cycle_time, case.closed_form),
+        {"elements": 96, "model": "time_stepped", "domain_radius": 1e-3},
+    )
+    sim = ContactSimulator(contact)
+    sim.step(1e-3, depth=2.0 * case.depth_scale)
+    fast = reference_stepper.MinimalStepper.on_grid_of(sim)
+    plain = PlainMinimalStepper.on_grid_of(sim)
+    scale = case.depth_scale
+    depths = scale * np.concatenate(
+        [
+            np.linspace(0.0, 2.0, 61)[1:],
+            np.linspace(2.0, -2.0, 200)[1:],
+            np.linspace(-2.0, 1.5, 80)[1:],
+            np.full(50, 1.5),
+        ]
+    )
+    memory = np.zeros_like(sim._model.row.wl)
+    forces, radii = [], []
+    for stepper in (fast, plain):
+        stepper.set_state(depth=0.0, radius=0.0, memory=memory)
+        force = np.empty(depths.size)
+        radius = np.empty(depths.size)
+        for index, depth in enumerate(depths):
+            # A step length that changes now and then: the fast stepper's cached matrices.
+            force[index] = stepper.step(1e-3 if index % 7 else 2e-3, float(depth))
+            radius[index] = stepper.radius
+        forces.append(force)
+        radii.append(radius)
+    pull_off = abs(float(np.min(forces[1])))
+    assert np.any(radii[1] > 0.0) and np.any(np.diff((radii[1] > 0.0).astype(int)) < 0), "no pull-off"
+    np.testing.assert_allclose(radii[0], radii[1], rtol=1e-10, atol=1e-12 * sim._model.row.dx)
+    assert np.max(np.abs(forces[0] - forces[1])) <= 1e-10 * pull_off
+    # The batch entry point is the same stepper.
+    fast.set_state(depth=0.0, radius=0.0, memory=memory)
+    batch = fast.run(1e-3, depths)
+    fast.set_state(depth=0.0, radius=0.0, memory=memory)
+    single = np.array([fast.step(1e-3, float(d)) for d in depths])
+    np.testing.assert_array_equal(batch, single)
+
+
 def test_step_costs_names_the_jump_rows_and_the_ratios() -> None:
     costs = kernel.step_costs(repeats=1, seconds=1.0)
     assert_finite_numbers(costs, "step costs")
