@@ -1,7 +1,12 @@
 """Numba kernels of the time-stepped MDR model (private).
 
 All kernels work in place on preallocated float64 arrays owned by the simulator and release
-the GIL (`nogil=True`: a long history in a service thread does not block the node). The
+the GIL (`nogil=True`: a long history in a service thread does not block the node). They are
+compiled without numba's runtime (`_nrt=False`): they allocate nothing (but `_kelvin_update`,
+a test and warm-up entry), and with the runtime every array passed to a compiled callee, every
+view taken (``coef[_C_E]``, a reshape) and every tuple unpacked costs an atomic increment and
+decrement of its reference count: about 3.7 of the 5.5 us of a one-substep step at N = 64,
+K = 1 (0.4.0 round: the same bits, measured side by side in one process). The
 public wrappers at the bottom validate shapes, dtypes and finiteness *before* entering
 numba (a NaN that slips into a compiled loop would spread silently), and `warm_up()`
 compiles and calls every kernel once so the first real step does not stall.
@@ -101,7 +106,7 @@ EDGE_TOLERANCE = 1e-12
 TOUCH_BLOCK = 32
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
 def _phi(x: float) -> tuple:
     """Return ``(exp(-x), (1-exp(-x))/x, (x-1+exp(-x))/x^2)`` for x >= 0, safe at both ends."""
     if x < _SERIES_LIMIT:
@@ -115,7 +120,7 @@ def _phi(x: float) -> tuple:
     return e, one_minus / x, (x - one_minus) / (x * x)
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _psi(x: float) -> tuple:
     """Integrals for the damper work over a step of length h with ``x = lam h``, E = exp(-lam t),
     F = (1 - E)/lam: ``(int E^2, int E F / h, int F^2 / h^2) / h`` =
@@ -144,7 +149,7 @@ def _psi(x: float) -> tuple:
     return p2, (p1 - p2) / x, (1.0 - 2.0 * p1 + p2) / (x * x)
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
 def _interior_count(a: float, dx: float, n: int) -> int:
     """Number of elements in contact for radius ``a``: centres below ``a``, >= 1 if a > 0."""
     if a <= 0.0:
@@ -157,7 +162,7 @@ def _interior_count(a: float, dx: float, n: int) -> int:
     return count
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
 def _g_at(x: float, gf: np.ndarray, df: float) -> float:
     """Profile g at ``x`` by linear interpolation on the fine grid."""
     m = gf.shape[0]
@@ -170,14 +175,14 @@ def _g_at(x: float, gf: np.ndarray, df: float) -> float:
     return gf[j] + t * (gf[j + 1] - gf[j])
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
 def _minmod(slope: float, before: float) -> float:
     if slope * before <= 0.0:
         return 0.0
     return slope if abs(slope) < abs(before) else before
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
 def _side_ab(x, values, units, lo, hi, dx, g_c):
     """``(A(x), B(x))`` from the elements lo..hi of one side of the edge.
 
@@ -234,14 +239,14 @@ def _side_ab(x, values, units, lo, hi, dx, g_c):
     return w_x + g_x * b_x, b_x
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
 def _w_side(x, values, units, lo, hi, dx, g_c, gf, df):
     """Memory ``w(x) = A(x) - g(x) B(x)`` at x from the elements lo..hi of one side, m."""
     a_x, b_x = _side_ab(x, values, units, lo, hi, dx, g_c)
     return a_x - _g_at(x, gf, df) * b_x
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
 def _h(x, d, wsum, bsum, lo, hi, dx, g_c, gf, df, c_crit):
     """Criterion gap h(x) with the memory of elements lo..hi (one side of the edge)."""
     g = _g_at(x, gf, df)
@@ -254,13 +259,13 @@ def _h(x, d, wsum, bsum, lo, hi, dx, g_c, gf, df, c_crit):
 _ROOT_SLACK = 3
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _bisect(x_lo, x_hi, d, wsum, bsum, lo, hi, dx, g_c, gf, df, c_crit):
     """`_edge_root` without the end values (it evaluates h there)."""
     return _edge_root(x_lo, x_hi, math.nan, math.nan, d, wsum, bsum, lo, hi, dx, g_c, gf, df, c_crit)
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _edge_root(x_lo, x_hi, f_lo, f_hi, d, wsum, bsum, lo, hi, dx, g_c, gf, df, c_crit):
     """Root of h between x_lo (h >= 0) and x_hi (h < 0), to ``EDGE_TOLERANCE * dx``: far
     below the discretisation error. Returns the midpoint of a bracket no wider than the
@@ -339,7 +344,7 @@ def _edge_root(x_lo, x_hi, f_lo, f_hi, d, wsum, bsum, lo, hi, dx, g_c, gf, df, c
     return 0.5 * (a + b)
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _h_bounds(b, d, wsum, bsum, lo, hi, dx, g_c, gf, gmin, gmax, df, c_crit):
     """Lower and upper bounds of h at the fine points of block b (`TOUCH_BLOCK` points)
     with the memory of elements lo..hi, m.
@@ -389,7 +394,7 @@ def _h_bounds(b, d, wsum, bsum, lo, hi, dx, g_c, gf, gmin, gmax, df, c_crit):
     return lower, upper
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _scan_out(x_start, d, wsum, bsum, lo, hi, dx, g_c, gf, gmin, gmax, df, c_crit, reach, x_stop):
     """Outermost point of the h >= 0 run that starts at x_start (exterior memory): the
     first fine point beyond x_start where h < 0, its root against the point before (`_edge_root`).
@@ -442,7 +447,7 @@ def _scan_out(x_start, d, wsum, bsum, lo, hi, dx, g_c, gf, gmin, gmax, df, c_cri
 _TOUCH_GROUP = 16
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _group_cannot_touch(b0, b1, d, wsum, bsum, dx, g_c, gmin, gmax, df, m):
     """True if no fine point of blocks b0..b1-1 can touch: `_first_touch`'s block test with
     the extremes over all those blocks. Every operand of the group's lower bound is at most
@@ -490,7 +495,7 @@ def _group_cannot_touch(b0, b1, d, wsum, bsum, dx, g_c, gmin, gmax, df, m):
     return d - lower < -margin
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _first_touch(d, wsum, bsum, dx, g_c, gf, gmin, gmax, df, reach):
     """First fine point (index) where the surface with its memory reaches the indenter,
     ``d - g - w >= 0``, or -1 if none up to `reach`.
@@ -559,7 +564,7 @@ def _first_touch(d, wsum, bsum, dx, g_c, gf, gmin, gmax, df, reach):
     return -1
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _locate_edge(a, d, wsum, bsum, dx, g_c, gf, gmin, gmax, df, c_crit, reach, max_move):
     """Apply the energy criterion both ways at depth d. Returns (new radius, motion, grow).
 
@@ -622,7 +627,7 @@ def _locate_edge(a, d, wsum, bsum, dx, g_c, gf, gmin, gmax, df, c_crit, reach, m
     return a, MOTION_NONE, False
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _profile_integral(a, gf, gint, df):
     """Integral of g over (0, a), m^2, consistent with the linear fine-grid profile."""
     m = gf.shape[0]
@@ -633,7 +638,7 @@ def _profile_integral(a, gf, gint, df):
     return gint[j] + 0.5 * (a - xj) * (gf[j] + _g_at(a, gf, df))
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _deviation_integral(a, d, wsum, bsum, n_in, dx, g_c, gf, gint, df, kap):
     """Integral over (0, a) of the interior memory's deviation from relaxed,
     ``dev = w - kap u = (A - kap d) - g (B - kap)``, m^2.
@@ -674,7 +679,7 @@ def _deviation_integral(a, d, wsum, bsum, n_in, dx, g_c, gf, gint, df, kap):
     return total
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _force(a, d, wsum, bsum, dx, g_c, gf, gint, df, e0, kap):
     """Normal force ``F = 2 E0* int_0^a (u - w) dx = 2 E0* ((1-kap) int u - int dev)``, N,
     with ``dev = w - kap u`` the memory's deviation from relaxed (zero when relaxed, so
@@ -689,7 +694,7 @@ def _force(a, d, wsum, bsum, dx, g_c, gf, gint, df, e0, kap):
     return 2.0 * e0 * ((1.0 - kap) * u_int - dev)
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _contact_coefficients(lam, dt, e, phi1, chi, cee, cef, cff):
     """Per-mode coefficients of the exact linear-input update over dt (e, phi1, chi) and
     of the damper work over it (cee, cef, cff; see `_chain_in_contact`)."""
@@ -705,7 +710,7 @@ def _contact_coefficients(lam, dt, e, phi1, chi, cee, cef, cff):
         cff[m] = p_ff * dt * dt * dt
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
 def _chain_in_contact(
     wl, wsum, wb, bsum, i, u0, u1, slope, p, p_inv, lam, beta, e, phi1, chi, cee, cef, cff, z, zb
 ):
@@ -749,7 +754,7 @@ def _chain_in_contact(
     return work
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
 def _chain_free(wl, wsum, wb, bsum, i, decay, e_kelvin):
     """Element i out of contact: each Kelvin element creeps back by its factor `decay`.
     Returns the Kelvin energy per unit width its dampers took, ``sum_k E_k (l^2 - l'^2)``."""
@@ -788,7 +793,7 @@ def coefficient_workspace(kelvin: int) -> np.ndarray:
     return coef
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _substep_coefficients(lam, rate, h, coef):
     """The in-contact coefficients and free decays over a substep of length h into ``coef``
     (`_contact_coefficients`, ``exp(-rate h)``), unless they already hold those of h."""
@@ -803,7 +808,7 @@ def _substep_coefficients(lam, rate, h, coef):
     coef[_C_SUBSTEP, 0] = h
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _update_range_one(
     wl,
     wsum,
@@ -880,7 +885,7 @@ def _update_range_one(
     return total, peak
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _update_range(
     wl,
     wsum,
@@ -974,7 +979,7 @@ def _update_range(
     return total, peak
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True)  # allocates its workspace: needs the runtime
 def _kelvin_update(wl, wsum, wb, bsum, diss, n_in, d0, d1, dt, g_c, p, p_inv, lam, beta, rate, e_kelvin, dx):
     """Exact update of every Kelvin chain over dt for a depth linear from d0 to d1.
 
@@ -1017,7 +1022,7 @@ def _kelvin_update(wl, wsum, wb, bsum, diss, n_in, d0, d1, dt, g_c, p, p_inv, la
     )
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _retime_crossed(
     wl,
     wsum,
@@ -1170,13 +1175,13 @@ def _retime_crossed(
     return hysteresis
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _copy_state(src, src_b, dst, dst_b):
     """Copy the memory (wl, wb) into (dst, dst_b); all C-contiguous (N, K)."""
     _copy_range(src, src_b, dst, dst_b, 0, src.shape[0])
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _copy_range(src, src_b, dst, dst_b, lo, hi):
     """`_copy_state` of elements lo..hi-1, as flat copies (a loop over (i, k) with a runtime K
     does not vectorise: 6 ns per element against 0.5)."""
@@ -1192,7 +1197,7 @@ def _copy_range(src, src_b, dst, dst_b, lo, hi):
         flat_dst[j] = flat_src[j]
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _restore_range(wl, wsum, wb, bsum, src, src_b, lo, hi):
     """`_restore_state` of elements lo..hi-1."""
     _copy_range(src, src_b, wl, wb, lo, hi)
@@ -1206,12 +1211,12 @@ def _restore_range(wl, wsum, wb, bsum, src, src_b, lo, hi):
         bsum[i] = total_b
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _restore_state(wl, wsum, wb, bsum, src, src_b):
     _restore_range(wl, wsum, wb, bsum, src, src_b, 0, wl.shape[0])
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _edge_outputs(a, d, wsum, bsum, dx, g_c, gf, df, c_crit, out):
     """Write the edge gaps on both sides and g at the edge into ``out`` (zeros without contact)."""
     if a > 0.0:
@@ -1226,7 +1231,7 @@ def _edge_outputs(a, d, wsum, bsum, dx, g_c, gf, df, c_crit, out):
         out[OUT_G_EDGE] = 0.0
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _trial_window(a, n_in, n, dx, df, max_move):
     """Elements ``lo..hi-1`` that a substep trial must update before `_locate_edge` with the
     motion limit ``max_move`` (m) from the radius ``a > 0``: every element that search reads.
@@ -1252,7 +1257,7 @@ def _trial_window(a, n_in, n, dx, df, max_move):
     return lo, hi
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _advance(
     wl,
     wsum,
@@ -1338,7 +1343,7 @@ def _advance(
     )
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _advance_from(
     wl,
     wsum,
@@ -1615,7 +1620,7 @@ def _advance_from(
     return STATUS_OK
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _advance_rows(
     wl,
     wsum,
@@ -1728,7 +1733,7 @@ def _advance_rows(
     return times.shape[0], STATUS_OK
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _remap(wl, wb, a, dx, g_c, new_dx, new_gc, out, out_b):
     """Kelvin state of a regridded row (element width new_dx, profile new_gc at its
     centres) into ``out``/``out_b`` (N', K).
@@ -1755,7 +1760,7 @@ def _remap(wl, wb, a, dx, g_c, new_dx, new_gc, out, out_b):
                 out[i, k] = a_x - new_gc[i] * b_x
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _energy_density(x, d, interior, n_in, wl, wb, dx, g_c, gf, df, e0, e_kelvin):
     """Spring energy per unit length at x, J/m: E0* l0^2 + sum_k E_k* l_k^2 (both half-rows),
     each ``l_k = A_k - g B_k`` interpolated on its side of the edge like the memory."""
@@ -1775,7 +1780,7 @@ def _energy_density(x, d, interior, n_in, wl, wb, dx, g_c, gf, df, e0, e_kelvin)
     return total
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _side_energy(x0, x1, d, interior, n_in, wl, wb, dx, g_c, gf, df, e0, e_kelvin):
     """Integral of `_energy_density` over (x0, x1) on one side of the edge, J: composite
     Simpson (two panels) on each piece between element centres, where A and B are linear."""
@@ -1803,7 +1808,7 @@ def _side_energy(x0, x1, d, interior, n_in, wl, wb, dx, g_c, gf, df, e0, e_kelvi
     return total
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _memory_peak(wsum):
     """Largest |wsum|, m: whether any memory is left (the simulator's idle test)."""
     peak = 0.0
@@ -1812,7 +1817,7 @@ def _memory_peak(wsum):
     return peak
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _stored_energy(a, d, wl, wb, dx, g_c, gf, df, e0, e_kelvin):
     """Elastic energy in all springs of both half-rows, J: the integral of
     `_energy_density` over the contact (interior memory) and over (a, L) (exterior).
@@ -1828,7 +1833,7 @@ def _stored_energy(a, d, wl, wb, dx, g_c, gf, df, e0, e_kelvin):
     return total
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _block_extremes(gf, gmin, gmax):
     """Least and largest of each block of `TOUCH_BLOCK` points of ``gf`` (finite) into
     ``gmin``/``gmax``: ``np.minimum.reduceat`` / ``np.maximum.reduceat`` over the block starts
@@ -1851,7 +1856,7 @@ def _block_extremes(gf, gmin, gmax):
 _REGRID_ARRAYS = ("g_c", "gf", "gint", "wl", "wb")
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True)  # slice copies need the runtime; once per regrid
 def _fill_regrid(const, state, chain_from, g_c, gf, gint, wl, wb, dx, df, e0, c_crit, reach, kap):
     """`Row.regrid`'s buffers: ``const`` (header, geometry, block extremes, the chain copied
     from the end of ``chain_from``) and ``state`` (zeros on entry: the memory, the coefficient
@@ -1911,7 +1916,7 @@ def _fill_regrid(const, state, chain_from, g_c, gf, gint, wl, wb, dx, df, e0, c_
 # Public wrappers: validate, then call the compiled kernel.
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _all_finite(values):
     """True if every entry of the 1-D array is finite (stops at the first that is not)."""
     for i in range(values.shape[0]):
@@ -2137,6 +2142,8 @@ def _unpack(state, const):
 # (`viscoadh bench --sections node`, side by side within minutes) the node's p50 rose
 # 1.4-1.8 -> 3.3-3.6 ms and its drops 5-12k -> 25-29k: rclpy's own threads move while the
 # kernel runs. Decide threading changes on the DDS measurement, not the in-process profile.
+# With the runtime: it makes the views it passes on (`_unpack`, `_view`; views of a raw pointer
+# carry no reference count, so the runtime costs nothing here).
 @numba.njit(cache=True, nogil=True)
 def _advance_packed(state, const, journal, a, d0, d1, dt, max_substep, max_edge_move):
     """`_advance` on the row whose buffers are `state` and `const` (`Row._state`,
