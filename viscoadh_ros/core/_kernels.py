@@ -1077,6 +1077,11 @@ def _retime_crossed(
     slope = (db - da) / dt if dt > 0.0 else 0.0
     hysteresis = 0.0
     lo, hi = (n0, n1) if n1 > n0 else (n1, n0)
+    # The lengths the retime coefficients and decays in ``coef`` were last computed for: the
+    # elements of a snap-in from no contact or of a fold to none all switch at the same f, so
+    # they are computed once, not once per element (the same numbers either way).
+    coef_length = math.nan
+    decay_length = math.nan
     for i in range(lo, hi):
         xi = (i + 0.5) * dx
         if a0 <= 0.0:
@@ -1099,13 +1104,17 @@ def _retime_crossed(
         first, second = f * dt, (1.0 - f) * dt
         lost = 0.0
         if n1 > n0:
-            for k in range(k_count):
-                decay[k] = math.exp(-rate[k] * first)
+            if first != decay_length:
+                for k in range(k_count):
+                    decay[k] = math.exp(-rate[k] * first)
+                decay_length = first
             lost += dx * _chain_free(wl, wsum, wb, bsum, i, decay, e_kelvin)
             l0 = d_switch - g_c[i] - wsum[i]
             hysteresis += e0 * dx * (c_crit * c_crit * xi - l0 * l0)
             if k_count:
-                _contact_coefficients(lam, second, e, phi1, chi, cee, cef, cff)
+                if second != coef_length:
+                    _contact_coefficients(lam, second, e, phi1, chi, cee, cef, cff)
+                    coef_length = second
                 lost += (
                     2.0
                     * dx
@@ -1134,7 +1143,9 @@ def _retime_crossed(
                 )
         else:
             if k_count:
-                _contact_coefficients(lam, first, e, phi1, chi, cee, cef, cff)
+                if first != coef_length:
+                    _contact_coefficients(lam, first, e, phi1, chi, cee, cef, cff)
+                    coef_length = first
                 lost += (
                     2.0
                     * dx
@@ -1163,8 +1174,10 @@ def _retime_crossed(
                 )
             l0 = d_switch - g_c[i] - wsum[i]
             hysteresis += e0 * dx * (l0 * l0 - c_crit * c_crit * xi)
-            for k in range(k_count):
-                decay[k] = math.exp(-rate[k] * second)
+            if second != decay_length:
+                for k in range(k_count):
+                    decay[k] = math.exp(-rate[k] * second)
+                decay_length = second
             lost += dx * _chain_free(wl, wsum, wb, bsum, i, decay, e_kelvin)
         diss[i] = lost
     return hysteresis
