@@ -1478,10 +1478,12 @@ def _advance_from(
     substeps = 0
     attempts = 0
     jumped_before = False
-    # Touch times planned this step (`_touch_time`) and whether the substep being tried ends
-    # just before a planned touch (then the jump substep follows).
+    # Touch times planned this step (`_touch_time`), whether the substep being tried ends
+    # just before a planned touch (then the jump substep follows) and whether it is the jump
+    # substep that crosses one.
     plans = 0
     jump_next = False
+    crossing = False
     # Largest |wsum| after the last accepted substep (summed with its update; K = 0: no memory).
     peak = 0.0
     if dt <= 0.0:
@@ -1597,10 +1599,12 @@ def _advance_from(
                 _restore_range(wl, wsum, wb, bsum, scratch, scratch_b, lo, hi)
             step = 0.5 * h
             jump_next = False
+            crossing = False
             if j_touch >= 0:
                 plans += 1
                 step = _touch_step(j_touch, tau, h, h_min, dt, d0, d1, wl, wb, dx, g_c, gf, df, rate, coef)
                 jump_next = step > h_min
+                crossing = not jump_next
             continue
         # Accepted: the elements before the window (in index order: their losses first) ...
         viscous = 0.0
@@ -1698,7 +1702,13 @@ def _advance_from(
         # after (racing across many cells) doubles back up as before: restarting from the
         # whole rest after every such substep would halve all the way down each time.
         step = dt if jumped and not jumped_before else 2.0 * h
-        if jump_next and a <= 0.0:
+        if crossing:
+            # The planned jump substep crossed the touch: the rest of the step at once, as
+            # after any jump, also where the contact then grows without jumping (a touch
+            # without adhesion), rather than doubling up from the jump substep.
+            step = dt
+        crossing = jump_next and a <= 0.0
+        if crossing:
             # The substep ended just before a planned touch: the jump substep crosses it.
             step = h_min
         jump_next = False
