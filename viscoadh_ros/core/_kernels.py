@@ -91,7 +91,8 @@ _PSI_SERIES_LIMIT = 0.5
 
 #: A true jump of the edge (snap-in, the fold at pull-off) is located in time to this
 #: fraction of the step: the substep that crosses it is this short (its work is a
-#: trapezoid over a depth change this small), found by halving from the whole step.
+#: trapezoid over a depth change this small), found by halving from the whole step (the
+#: fold) or, out of contact, centred on the touch time found in closed form (`_touch_time`).
 JUMP_RESOLUTION = 1e-4
 
 #: Edge roots are located to this fraction of an element width (`_bisect`).
@@ -1377,7 +1378,10 @@ def _advance(
 
     Substeps are halved while the edge would move more than ``max_edge_move`` (m) in one
     of them, down to ``JUMP_RESOLUTION dt``: a true jump (snap-in, the fold at pull-off) is thereby
-    located in time and crossed in one tiny substep that does no work. Writes radius,
+    located in time and crossed in one tiny substep that does no work. Out of contact a
+    rejected trial is not halved: the touch time of the point that touched is found in closed
+    form (`_touch_step`), one substep ends half a jump substep before it and the jump substep
+    of ``JUMP_RESOLUTION dt`` crosses it. Writes radius,
     force, work input, last motion, substep count, the energy dissipated over the step
     (>= 0), the largest |wsum|, the edge gaps and g at the edge to ``out``. Returns
     STATUS_GROW (state partly advanced: the caller restores) when the contact needs a larger
