@@ -14,6 +14,7 @@ import os
 import sys
 import time
 
+import ab_cores
 import numpy as np
 
 here = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -21,17 +22,11 @@ roots = {"old": os.path.abspath(sys.argv[1]), "new": here}
 repeats = int(sys.argv[2]) if len(sys.argv) > 2 else 7
 cores = {}
 for label, root in roots.items():
-    for key in [key for key in sys.modules if key.startswith("viscoadh_ros")]:
-        del sys.modules[key]
-    sys.path.insert(0, root)
-    from viscoadh_ros.bench.kernel import _scene_history
-    from viscoadh_ros.core import _kernels, simulator
-    from viscoadh_ros.core.config import SceneConfig, default_scene_path
-
-    assert _kernels.__file__.startswith(root), _kernels.__file__
-    _kernels.warm_up()
-    cores[label] = (simulator, SceneConfig.from_yaml(default_scene_path()).contacts[0])
-    sys.path.remove(root)
+    # The old core's kernels under their own module name (ab_cores says why).
+    core = ab_cores.load(root, rename_kernels=label == "old")
+    contact = core["config"].SceneConfig.from_yaml(core["config"].default_scene_path()).contacts[0]
+    cores[label] = (core["simulator"], contact)
+_scene_history = core["bench_kernel"]._scene_history
 
 times, depths = _scene_history(3.0)
 modes = ("depth", "force")
