@@ -1,7 +1,10 @@
 """Scenes whose outputs pin the compiled step bit for bit (issue 13, windowed substep trials).
 
 `tests/test_kernel_golden.py` runs every scene here and compares with
-`tests/data/kernel_golden.npz`, written by the 0.2.0 kernel (main before the windowed trials)::
+`tests/data/kernel_golden.npz`, written by the 0.2.0 kernel (main before the windowed trials),
+then again by the 0.4.0 kernel whose snap-in out of contact is located in time directly
+(`_kernels._touch_time`: a new substep partition around the touch changes the bits from a
+snap-in on; benchmarks/rounds/0.4.0-snap.md states by how much against the 0.2.0 file)::
 
     .venv/bin/python tests/kernel_golden.py <checkout root of the reference> tests/data/kernel_golden.npz
 

@@ -6,11 +6,14 @@ array per scene: a row per public call (the 11 `StepOutput` fields, phase as its
 memory digest, so "nothing changed" is compared too) and the memory digest after each call.
 The golden `data/step_golden.npz` was written from the 0.2.0 step path (main at fecbb5f) by
 ``python tests/step_scenarios.py tests/data/step_golden.npz`` and is compared bit for bit by
-tests/test_step_lean.py. Force control is kept out (its search is tuned separately); the
-scenes cover snap-in, sticking, pull-off, out of contact with memory, re-contact, depth jumps at
-one time, domain growth, refused calls mid-way (bad numbers, time going back, a contact the
-domain cannot represent), reset, snapshot/restore into the same and another simulator,
-`advance` and `step_depths` between steps.
+tests/test_step_lean.py; it was written again in 0.4.0 when the snap-in out of contact came to
+be located in time directly (`_kernels._touch_time`: another substep partition, so other bits
+from a snap-in on; the round file benchmarks/rounds/0.4.0-snap.md states by how much). Force
+control is kept out (its search is tuned separately); the scenes cover snap-in, sticking,
+pull-off, out of contact with memory, re-contact, depth jumps at one time, domain growth,
+refused calls mid-way (bad numbers, time going back, a contact the domain cannot represent),
+reset, snapshot/restore into the same and another simulator, `advance` and `step_depths`
+between steps.
 """
 
 from __future__ import annotations

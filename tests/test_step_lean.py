@@ -3,7 +3,8 @@
 `step_scenarios` records varied sequences (snap-in, pull-off, out of contact with memory,
 depth jumps at one time, domain growth, refused calls mid-way, reset, snapshot/restore into the
 same and another simulator, `advance`, `step_depths`); the golden was written from main at
-fecbb5f before the lean step path and the packed kernel call. Since the 0.3.0 edge root finder
+fecbb5f before the lean step path and the packed kernel call, and written again in 0.4.0 by
+the snap-in located in time directly (`step_scenarios` says why). Since the 0.3.0 edge root finder
 moved edges by up to 1e-12 of an element, the golden comparison allows `golden_tolerance`'s
 tolerance where the bits differ (the twins below stay bit for bit).
 """

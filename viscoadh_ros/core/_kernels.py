@@ -96,7 +96,8 @@ _PSI_SERIES_LIMIT = 0.5
 
 #: A true jump of the edge (snap-in, the fold at pull-off) is located in time to this
 #: fraction of the step: the substep that crosses it is this short (its work is a
-#: trapezoid over a depth change this small), found by halving from the whole step.
+#: trapezoid over a depth change this small), found by halving from the whole step (the
+#: fold) or, out of contact, centred on the touch time found in closed form (`_touch_time`).
 JUMP_RESOLUTION = 1e-4
 
 #: Edge roots are located to this fraction of an element width (`_bisect`).
@@ -1082,6 +1083,11 @@ def _retime_crossed(
     slope = (db - da) / dt if dt > 0.0 else 0.0
     hysteresis = 0.0
     lo, hi = (n0, n1) if n1 > n0 else (n1, n0)
+    # The lengths the retime coefficients and decays in ``coef`` were last computed for: the
+    # elements of a snap-in from no contact or of a fold to none all switch at the same f, so
+    # they are computed once, not once per element (the same numbers either way).
+    coef_length = math.nan
+    decay_length = math.nan
     for i in range(lo, hi):
         xi = (i + 0.5) * dx
         if a0 <= 0.0:
@@ -1104,13 +1110,17 @@ def _retime_crossed(
         first, second = f * dt, (1.0 - f) * dt
         lost = 0.0
         if n1 > n0:
-            for k in range(k_count):
-                decay[k] = math.exp(-rate[k] * first)
+            if first != decay_length:
+                for k in range(k_count):
+                    decay[k] = math.exp(-rate[k] * first)
+                decay_length = first
             lost += dx * _chain_free(wl, wsum, wb, bsum, i, decay, e_kelvin)
             l0 = d_switch - g_c[i] - wsum[i]
             hysteresis += e0 * dx * (c_crit * c_crit * xi - l0 * l0)
             if k_count:
-                _contact_coefficients(lam, second, e, phi1, chi, cee, cef, cff)
+                if second != coef_length:
+                    _contact_coefficients(lam, second, e, phi1, chi, cee, cef, cff)
+                    coef_length = second
                 lost += (
                     2.0
                     * dx
@@ -1139,7 +1149,9 @@ def _retime_crossed(
                 )
         else:
             if k_count:
-                _contact_coefficients(lam, first, e, phi1, chi, cee, cef, cff)
+                if first != coef_length:
+                    _contact_coefficients(lam, first, e, phi1, chi, cee, cef, cff)
+                    coef_length = first
                 lost += (
                     2.0
                     * dx
@@ -1168,8 +1180,10 @@ def _retime_crossed(
                 )
             l0 = d_switch - g_c[i] - wsum[i]
             hysteresis += e0 * dx * (l0 * l0 - c_crit * c_crit * xi)
-            for k in range(k_count):
-                decay[k] = math.exp(-rate[k] * second)
+            if second != decay_length:
+                for k in range(k_count):
+                    decay[k] = math.exp(-rate[k] * second)
+                decay_length = second
             lost += dx * _chain_free(wl, wsum, wb, bsum, i, decay, e_kelvin)
         diss[i] = lost
     return hysteresis
@@ -1257,6 +1271,76 @@ def _trial_window(a, n_in, n, dx, df, max_move):
     return lo, hi
 
 
+#: Touch times `_advance_from` may plan in one step (`_touch_time`) before it falls back to
+#: halving the substep: each plan ends the step's search earlier by at least half a jump
+#: substep, and one or two suffice unless the first touch hops between distant points.
+_MAX_TOUCH_PLANS = 8
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
+def _touch_gap(s, tau, dt, d0, d1, g_j, modes, rate):
+    """``d - g - w`` at one fine point a time s after tau of a row out of contact, its memory
+    ``w = sum_k modes[k] exp(-rate[k] s)`` (each Kelvin element creeps back freely)."""
+    w = 0.0
+    for k in range(rate.shape[0]):
+        w += modes[k] * math.exp(-rate[k] * s)
+    return d0 + (d1 - d0) * ((tau + s) / dt) - g_j - w
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _touch_time(j, tau, h, dt, d0, d1, wl, wb, dx, g_c, gf, df, rate, modes):
+    """When, within ``[0, h]`` after tau, fine point j of a row out of contact (radius 0)
+    reaches the indenter, s: the end of a bracket no wider than ``1e-3 JUMP_RESOLUTION dt``
+    where the gap ``d - g - w`` (`_first_touch`'s test) changes sign.
+
+    Out of contact every Kelvin element creeps back freely, and the whole row's memory at a
+    point is linear in the element values (`_side_ab` between centres, held beyond the
+    ends), so the memory at point j is a sum of one decaying exponential per mode, exact in
+    closed form at any time: the touch is found without updating the row (O(K) per trial
+    time instead of O(N K) plus a first-touch search). ``modes`` (K) is scratch. Returns 0 if
+    the point touches at tau already, h if it does not touch by tau + h (rounding)."""
+    n, k_count = wl.shape
+    xj = j * df
+    g_j = gf[j]
+    g_x = _g_at(xj, gf, df)
+    for k in range(k_count):
+        a_k, b_k = _side_ab(xj, wl[:, k], wb[:, k], 0, n - 1, dx, g_c)
+        modes[k] = a_k - g_x * b_k
+    if _touch_gap(0.0, tau, dt, d0, d1, g_j, modes, rate) >= 0.0:
+        return 0.0
+    if _touch_gap(h, tau, dt, d0, d1, g_j, modes, rate) < 0.0:
+        return h
+    lo = 0.0
+    hi = h
+    tol = 1e-3 * JUMP_RESOLUTION * dt
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        if hi - lo <= tol or mid <= lo or mid >= hi:
+            break
+        if _touch_gap(mid, tau, dt, d0, d1, g_j, modes, rate) >= 0.0:
+            hi = mid
+        else:
+            lo = mid
+    return hi
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _touch_step(j, tau, h, h_min, dt, d0, d1, wl, wb, dx, g_c, gf, df, rate, coef):
+    """The substep to try from tau after a trial of length h out of contact touched at fine
+    point j (`_advance_from`): up to half a jump substep (``h_min``) before the point's touch
+    time (`_touch_time`), so that the jump substep of length ``h_min`` that follows is
+    centred on the touch; ``h_min`` itself (the jump substep) if the touch is that close.
+
+    A trial that ends there is checked as any other: if another point touches earlier it is
+    rejected and the touch is planned again from that point (each plan ends at least half a
+    jump substep earlier); if it touches within the motion limit it is accepted in contact."""
+    s = _touch_time(j, tau, h, dt, d0, d1, wl, wb, dx, g_c, gf, df, rate, coef[_C_Z])
+    before = s - 0.5 * h_min
+    if before <= 0.0:
+        return h_min
+    return before
+
+
 @numba.njit(cache=True, nogil=True, _nrt=False)
 def _advance(
     wl,
@@ -1299,7 +1383,10 @@ def _advance(
 
     Substeps are halved while the edge would move more than ``max_edge_move`` (m) in one
     of them, down to ``JUMP_RESOLUTION dt``: a true jump (snap-in, the fold at pull-off) is thereby
-    located in time and crossed in one tiny substep that does no work. Writes radius,
+    located in time and crossed in one tiny substep that does no work. Out of contact a
+    rejected trial is not halved: the touch time of the point that touched is found in closed
+    form (`_touch_step`), one substep ends half a jump substep before it and the jump substep
+    of ``JUMP_RESOLUTION dt`` crosses it. Writes radius,
     force, work input, last motion, substep count, the energy dissipated over the step
     (>= 0), the largest |wsum|, the edge gaps and g at the edge to ``out``. Returns
     STATUS_GROW (state partly advanced: the caller restores) when the contact needs a larger
@@ -1400,6 +1487,12 @@ def _advance_from(
     substeps = 0
     attempts = 0
     jumped_before = False
+    # Touch times planned this step (`_touch_time`), whether the substep being tried ends
+    # just before a planned touch (then the jump substep follows) and whether it is the jump
+    # substep that crosses one.
+    plans = 0
+    jump_next = False
+    crossing = False
     # Largest |wsum| after the last accepted substep (summed with its update; K = 0: no memory).
     peak = 0.0
     if dt <= 0.0:
@@ -1506,9 +1599,21 @@ def _advance_from(
             return STATUS_GROW
         attempts += 1
         if abs(new_a - a) > max_edge_move and limited:
+            # Out of contact a rejected trial found the first touch (a snap-in): locate it
+            # in time directly instead of halving ~14 times, each a whole-row trial.
+            j_touch = -1
+            if a <= 0.0 and plans < _MAX_TOUCH_PLANS:
+                j_touch = _first_touch(db, wsum, bsum, dx, g_c, gf, gmin, gmax, df, reach)
             if k_count:
                 _restore_range(wl, wsum, wb, bsum, scratch, scratch_b, lo, hi)
             step = 0.5 * h
+            jump_next = False
+            crossing = False
+            if j_touch >= 0:
+                plans += 1
+                step = _touch_step(j_touch, tau, h, h_min, dt, d0, d1, wl, wb, dx, g_c, gf, df, rate, coef)
+                jump_next = step > h_min
+                crossing = not jump_next
             continue
         # Accepted: the elements before the window (in index order: their losses first) ...
         viscous = 0.0
@@ -1606,6 +1711,16 @@ def _advance_from(
         # after (racing across many cells) doubles back up as before: restarting from the
         # whole rest after every such substep would halve all the way down each time.
         step = dt if jumped and not jumped_before else 2.0 * h
+        if crossing:
+            # The planned jump substep crossed the touch: the rest of the step at once, as
+            # after any jump, also where the contact then grows without jumping (a touch
+            # without adhesion), rather than doubling up from the jump substep.
+            step = dt
+        crossing = jump_next and a <= 0.0
+        if crossing:
+            # The substep ended just before a planned touch: the jump substep crosses it.
+            step = h_min
+        jump_next = False
         jumped_before = jumped
         if max_substep > 0.0 and step > max_substep:
             step = max_substep
