@@ -1971,7 +1971,7 @@ def _block_extremes(gf, gmin, gmax):
 _REGRID_ARRAYS = ("g_c", "gf", "gint", "wl", "wb")
 
 
-@numba.njit(cache=True, nogil=True)  # slice copies need the runtime; once per regrid
+@numba.njit(cache=True, nogil=True, _nrt=False)
 def _fill_regrid(const, state, chain_from, g_c, gf, gint, wl, wb, dx, df, e0, c_crit, reach, kap):
     """`Row.regrid`'s buffers: ``const`` (header, geometry, block extremes, the chain copied
     from the end of ``chain_from``) and ``state`` (zeros on entry: the memory, the coefficient
@@ -1998,22 +1998,30 @@ def _fill_regrid(const, state, chain_from, g_c, gf, gint, wl, wb, dx, df, e0, c_
     const[7] = c_crit
     const[8] = reach
     const[9] = kap
+    # Element by element (a slice assignment may copy through a temporary: the runtime).
     at = PACK_HEADER
-    const[at : at + n] = g_c
+    for i in range(n):
+        const[at + i] = g_c[i]
     at += n
-    const[at : at + m] = gf
+    for j in range(m):
+        const[at + j] = gf[j]
     at += m
-    const[at : at + m] = gint
+    for j in range(m):
+        const[at + j] = gint[j]
     at += m
     _block_extremes(gf, const[at : at + blocks], const[at + blocks : at + 2 * blocks])
     at += 2 * blocks
     chain = 2 * k * k + 4 * k
-    const[at : at + chain] = chain_from[chain_from.shape[0] - chain :]
+    first = chain_from.shape[0] - chain
+    for j in range(chain):
+        const[at + j] = chain_from[first + j]
     # state: wl, wsum, wb, bsum, scratch, scratch_b, diss, out, txn, txn_b, coef
     size = n * k
-    state[0:size] = wl.reshape(size)
     at = size + n
-    state[at : at + size] = wb.reshape(size)
+    for i in range(n):
+        for kk in range(k):
+            state[i * k + kk] = wl[i, kk]
+            state[at + i * k + kk] = wb[i, kk]
     if k == 1:
         # numpy's wl.sum(axis=1) over one column: 0.0 + w (a -0.0 becomes +0.0).
         for i in range(n):
