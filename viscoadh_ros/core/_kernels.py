@@ -1305,28 +1305,52 @@ def _block_change(sign, lo, hi, wl, wb, g_c, gf, gint, df, dx, coef):
     (g_{j-1} + g_j + 4 g_mid) / 6``: ``cb_i = q_i + q_{i+1}`` (``cb_0 = g_0 x0 - G(x0) +
     q_1``), ``r_0 = G(x0)`` (G: the profile's integral, x0 the first centre)."""
     n, k_count = wl.shape
+    if hi <= lo:
+        return 0.0, 0.0, 0.0
+    m = gf.shape[0]
+    per_cell = (m - 1) // n
+    on_grid = per_cell * n == m - 1
     x0 = 0.5 * dx
     sum_g = 0.0
     sum_cb = 0.0
     sum_r = 0.0
+    # g at the cell boundaries read once each; the sums in the modal scratch rows, then added.
+    gm = 0.0
+    if lo > 0:
+        gm = gf[per_cell * lo] if on_grid else _g_at(lo * dx, gf, df)
+    for k in range(k_count):
+        coef[_C_Z, k] = 0.0
+        coef[_C_ZB, k] = 0.0
+    acc_w = 0.0
+    acc_b = 0.0
     for i in range(lo, hi):
-        g_next = g_c[i + 1]
-        gm_next = _g_between(i + 1, gf, df, dx, n)
-        cb = dx * (g_c[i] + g_next - 2.0 * gm_next) / 6.0
+        gm_next = gf[per_cell * (i + 1)] if on_grid else _g_at((i + 1) * dx, gf, df)
+        g_i = g_c[i]
+        cb = dx * (g_i + g_c[i + 1] - 2.0 * gm_next) / 6.0
         if i == 0:
             g_x0 = _profile_integral(x0, gf, gint, df)
-            cb += g_c[0] * x0 - g_x0
+            cb += g_i * x0 - g_x0
             r = g_x0
         else:
-            gm = _g_between(i, gf, df, dx, n)
-            cb += dx * (g_c[i - 1] + g_c[i] - 2.0 * gm) / 6.0
-            r = dx * (g_c[i - 1] + g_c[i] + 4.0 * gm) / 6.0
-        for k in range(k_count):
-            coef[_C_AW, k] += sign * wl[i, k]
-            coef[_C_AB, k] += sign * cb * wb[i, k]
-        sum_g += g_c[i]
+            cb += dx * (g_c[i - 1] + g_i - 2.0 * gm) / 6.0
+            r = dx * (g_c[i - 1] + g_i + 4.0 * gm) / 6.0
+        gm = gm_next
+        if k_count == 1:
+            acc_w += wl[i, 0]
+            acc_b += cb * wb[i, 0]
+        else:
+            for k in range(k_count):
+                coef[_C_Z, k] += wl[i, k]
+                coef[_C_ZB, k] += cb * wb[i, k]
+        sum_g += g_i
         sum_cb += cb
         sum_r += r
+    if k_count == 1:
+        coef[_C_Z, 0] = acc_w
+        coef[_C_ZB, 0] = acc_b
+    for k in range(k_count):
+        coef[_C_AW, k] += sign * coef[_C_Z, k]
+        coef[_C_AB, k] += sign * coef[_C_ZB, k]
     return sign * sum_g, sign * sum_cb, sign * sum_r
 
 
