@@ -1,16 +1,18 @@
 """In-process A/B of two versions of the compiled kernel module on the kernel bench's scenario.
 
-    .venv/bin/python benchmarks/kernel_module_ab.py [--close] <old checkout root> N,K [N,K ...]
+    .venv/bin/python benchmarks/kernel_module_ab.py [--close] [--steps S] <old checkout root> N,K [N,K ...]
 
 Loads ``viscoadh_ros/core/_kernels.py`` of the old checkout as a separate module beside this
 checkout's, builds the `viscoadh bench --sections kernel` state for each (N, K) (standard
-solid pressed to the cycle's deepest point and back, then 400 rows of the 1 kHz cycle), and
-times, interleaved and median of 7 (31 at N <= 256), per row: `_advance` row by row in a
-compiled loop (old, new), `_advance_rows` (old, new) and `MinimalStepper.run`. The rows of
-both `_advance_rows` must be equal bit for bit (asserted), so the script also proves the new
-kernel's outputs on these scenes. With ``--close`` (a change meant to move the outputs at the
-rounding level, e.g. the 0.3.0 edge root finder) the largest difference of each output slot,
-relative to that slot's largest value (the edge gaps: the radius's), is printed instead.
+solid pressed to the cycle's deepest point and back, then 400 rows of the 1 kHz cycle, or S
+rows: ``--steps 100`` is the stretch `viscoadh bench` times per call from Python, with its K = 1
+snap-in and re-contact), and times, interleaved and median of 7 (31 at N <= 256), per row:
+`_advance` row by row in a compiled loop (old, new), `_advance_rows` (old, new) and
+`MinimalStepper.run`. The rows of both `_advance_rows` must be equal bit for bit (asserted),
+so the script also proves the new kernel's outputs on these scenes. With ``--close`` (a change
+meant to move the outputs at the rounding level, e.g. the 0.3.0 edge root finder) the largest
+difference of each output slot, relative to that slot's largest value (the edge gaps: the
+radius's), is printed instead.
 Only ratios from one sitting count (shared machine).
 """
 
@@ -200,6 +202,11 @@ def main() -> None:
     args = sys.argv[1:]
     close = "--close" in args
     args = [a for a in args if a != "--close"]
+    if "--steps" in args:
+        at = args.index("--steps")
+        global STEPS
+        STEPS = int(args[at + 1])
+        del args[at : at + 2]
     old = _old_module(args[0])
     for spec in args[1:]:
         elements, kelvin = (int(v) for v in spec.split(","))
