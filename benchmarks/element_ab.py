@@ -13,10 +13,14 @@ the in-contact step.)
 
 The old checkout's `viscoadh_ros/core` is copied into a temporary package (`_old_core`) with its
 own numba cache. Per (N, K), interleaved, median of repeats: `ContactSimulator.step` per call
-(old, new), `step_depths` over the same stretch (old, new) and the bench's `MinimalStepper.run`
-on the same grid, in ns per element step (N elements, one step). The outputs of both checkouts
-are compared: bit for bit (asserted), or with ``--close`` the largest difference of each output
-column relative to its largest value is printed.
+(old, new), the kernel `step` calls (`_advance_packed` with its journal, and for the new one
+the kept force, as `_TimeStepped.advance` passes them) in a compiled loop (old, new),
+`step_depths` over the same stretch (old, new) and the bench's `MinimalStepper.run` on the same
+grid, in ns per element step (N elements, one step). Timed in the thread's CPU time, not wall
+time: on a machine shared by several jobs (load 8-15 on 2 cores during the 0.4.0 round) wall
+times swung 3x between neighbouring repeats, CPU time much less (cache sharing still moves
+it). The outputs of both checkouts are compared: bit for bit (asserted), or with ``--close``
+the largest difference of each output column relative to its largest value is printed.
 """
 
 from __future__ import annotations
@@ -27,14 +31,15 @@ import math
 import shutil
 import sys
 import tempfile
+import time
 from pathlib import Path
 
+import numba
 import numpy as np
 
 from viscoadh_ros.bench import kernel as bench_kernel
 from viscoadh_ros.bench.accuracy import Case, cases, contact_config
 from viscoadh_ros.bench.reference_stepper import MinimalStepper
-from viscoadh_ros.bench.timing import interleaved_medians
 from viscoadh_ros.core.simulator import STEP_OUTPUT_FIELDS, ContactSimulator
 
 STEP_S = bench_kernel.STEP_S
@@ -66,6 +71,36 @@ def scene(simulator_class, elements: int, kelvin: int, steps: int):
     t = sim.time + STEP_S * np.arange(1, steps + 1)
     phase = 2.0 * math.pi * (t - sim.time) / PERIOD
     return sim, t, case.depth_scale * (PRESS + AMPLITUDE * np.sin(phase))
+
+
+def interleaved_cpu_medians(runs: dict, *, repeats: int) -> dict[str, float]:
+    """Median thread CPU time of each named run, s, the runs interleaved repeat by repeat."""
+    samples: dict[str, list[float]] = {name: [] for name in runs}
+    for _ in range(repeats):
+        for name, run in runs.items():
+            start = time.thread_time()
+            run()
+            samples[name].append(time.thread_time() - start)
+    return {name: float(np.median(values)) for name, values in samples.items()}
+
+
+def _packed_loop(advance_packed, kept: bool):
+    """The kernel calls of `_TimeStepped.advance` over a depth history, compiled: journal on,
+    and (``kept``) the force the call before ended with."""
+
+    @numba.njit
+    def loop(state, const, out, radius, depths, dt, max_substep, max_move):  # pragma: no cover
+        force = math.nan
+        for s in range(1, depths.shape[0]):
+            d0, d1 = depths[s - 1], depths[s]
+            if kept:
+                advance_packed(state, const, True, radius, d0, d1, dt, max_substep, max_move, force)
+            else:
+                advance_packed(state, const, True, radius, d0, d1, dt, max_substep, max_move)
+            radius = out[0]
+            force = out[1]
+
+    return loop
 
 
 def _columns(outputs) -> np.ndarray:
@@ -105,9 +140,34 @@ def measure(old_module, elements: int, kelvin: int, steps: int, repeats: int, cl
         minimal.set_state(depth=d_start, radius=radius, memory=wl0)
         minimal.run(STEP_S, depths)
 
+    history = np.concatenate(([d_start], depths))
+    max_substep = float(new.numerics.max_substep)
+    max_move = float(new.numerics.max_edge_cells * row.dx)
+    old_row = old._model.row
+    wb0 = row.memory()[1]
+    kernels = {"new": sys.modules["viscoadh_ros.core._kernels"], "old": sys.modules["_old_core._kernels"]}
+    kept = "force_prev" in kernels["new"]._advance_packed.py_func.__code__.co_varnames
+    old_kept = "force_prev" in kernels["old"]._advance_packed.py_func.__code__.co_varnames
+    loops = {
+        "new": _packed_loop(kernels["new"]._advance_packed, kept),
+        "old": _packed_loop(kernels["old"]._advance_packed, old_kept),
+    }
+
+    def kernel(key: str):
+        target = row if key == "new" else old_row
+
+        def run() -> None:
+            target.set_memory(wl0, wb0)
+            buffers = target._state, target._const, target.out
+            loops[key](*buffers, radius, history, STEP_S, max_substep, max_move)
+
+        return run
+
     runs = {
         "old step": per_call("old"),
         "new step": per_call("new"),
+        "old kernel": kernel("old"),
+        "new kernel": kernel("new"),
         "old rows": batch("old"),
         "new rows": batch("new"),
         "minimal": run_minimal,
@@ -131,7 +191,7 @@ def measure(old_module, elements: int, kelvin: int, steps: int, repeats: int, cl
         else:
             assert np.array_equal(a, b), f"the {kind} outputs differ"
             differ[kind] = 0.0
-    medians = interleaved_medians(runs, repeats=repeats)
+    medians = interleaved_cpu_medians(runs, repeats=repeats)
     per_element = {key: value / (steps * elements) * 1e9 for key, value in medians.items()}
     per_element.update(moved=moved, substeps=substeps, differ=differ)
     return per_element
@@ -152,17 +212,19 @@ def main() -> None:
         "in-contact 1 kHz steps)"
     )
     print(
-        "| N | K | step() old | new | old/new | step_depths old | new | old/new | minimal run "
-        "| rows new/minimal | edge move (cells) | outputs |"
+        "| N | K | step() old | new | old/new | kernel call old | new | old/new | step_depths old | new "
+        "| old/new | minimal run | rows new/minimal | edge move (cells) | outputs |"
     )
-    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for spec in args.cases:
         elements, kelvin = (int(v) for v in spec.split(","))
         r = measure(old_module, elements, kelvin, args.steps, args.repeats, args.close)
         note = "bit-equal" if not args.close else f"<= {max(r['differ'].values()):.1e} of each column"
         step, rows = (r["old step"], r["new step"]), (r["old rows"], r["new rows"])
+        kernel = r["old kernel"], r["new kernel"]
         print(
             f"| {elements} | {kelvin} | {step[0]:.2f} | {step[1]:.2f} | {step[0] / step[1]:.2f} "
+            f"| {kernel[0]:.2f} | {kernel[1]:.2f} | {kernel[0] / kernel[1]:.2f} "
             f"| {rows[0]:.2f} | {rows[1]:.2f} | {rows[0] / rows[1]:.2f} | {r['minimal']:.2f} "
             f"| {rows[1] / r['minimal']:.2f} | {r['moved']:.3f} | {note} |",
             flush=True,
