@@ -19,7 +19,7 @@ The 0.4.0 kernel (`elem`) sums the K = 1 update's losses in four interleaved lan
 one chain in index order (`_kernels._sum_losses`; one chain of dependent additions was
 latency-bound). Only the rounding of that sum changes: nothing in the state, the edge or the
 force reads it, so the energy dissipated alone moves, by the rounding of a sum of N
-non-negative terms (~N eps of it; on the golden scenes at most 2e-16 of its column's largest
+non-negative terms (~N eps of it; on the golden scenes at most 1.2e-15 of its column's largest
 value), far below `RELATIVE`; it stays non-negative and its running sum monotone.
 
 Force control (`FORCED_RELATIVE` = 1e-7): a force step stops anywhere inside its stop band
