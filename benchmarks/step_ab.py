@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import math
 import shutil
 import sys
 import tempfile
@@ -134,12 +135,12 @@ def split(elements: int, kelvin: int, repeats: int) -> dict[str, float]:
 
     def packed() -> None:
         row.set_memory(wl0, wb0)
-        a, previous, out = radius, float(depth[0]), row.out
+        a, previous, out, force = radius, float(depth[0]), row.out, math.nan
         for d in depths:
             _kernels._advance_packed(
-                row._state, row._const, True, a, previous, d, STEP_S, max_substep, max_edge_move
+                row._state, row._const, True, a, previous, d, STEP_S, max_substep, max_edge_move, force
             )
-            a, previous = float(out[0]), d
+            a, previous, force = float(out[0]), d, float(out[1])
 
     def compiled() -> None:
         row.set_memory(wl0, wb0)

@@ -15,6 +15,13 @@ decided by which way a 1e-13 dx jitter of the re-located edge went, in the golde
 The criterion gaps at the new edge (`_kernels.advance`'s outputs) are h at a root, rounding
 noise by definition: they are compared on the scale of the radius.
 
+The 0.4.0 kernel (`elem`) sums the K = 1 update's losses in four interleaved lanes instead of
+one chain in index order (`_kernels._sum_losses`; one chain of dependent additions was
+latency-bound). Only the rounding of that sum changes: nothing in the state, the edge or the
+force reads it, so the energy dissipated alone moves, by the rounding of a sum of N
+non-negative terms (~N eps of it; on the golden scenes at most 1.2e-15 of its column's largest
+value), far below `RELATIVE`; it stays non-negative and its running sum monotone.
+
 Force control (`FORCED_RELATIVE` = 1e-7): a force step stops anywhere inside its stop band
 (half the force tolerance, >= 1e-5 of the commanded force in every preset), so trials whose
 forces moved at the 1e-15 level may stop at another point of that band (two rows of one

@@ -454,6 +454,13 @@ class _TimeStepped:
         # Edge outputs of the last `advance` (gaps outside/inside, g at the edge) and its depth.
         self._edge = (0.0, 0.0, 0.0)
         self._edge_depth = math.nan
+        # (row, radius, depth, force) of the last `advance`: the force its kernel ended with, at
+        # that radius and depth on the row's memory as it left it. The next step starts there,
+        # so the kernel is handed that force instead of integrating it again (the same bits).
+        # Valid while only `advance` writes the row's memory: everything else that does
+        # (set_state, rewind, rollback, reset, drop_memory, advance_rows) drops it or, for a
+        # rollback, puts back the one from the transaction's start.
+        self._force_at: tuple | None = None
 
     # -- the domain ---------------------------------------------------------------------
     def _build_row(
@@ -627,6 +634,13 @@ class _TimeStepped:
         journal = self._journal is not row
         start = None if journal else self.get_state()
         radius0, dissipated0 = self.radius, self.dissipated
+        known = self._force_at
+        # A signed zero depth could give the force another sign of zero: integrate it then.
+        if known is not None and known[0] is row and known[1] == radius0 and known[2] == d0 and d0 != 0.0:
+            force_prev = known[3]
+        else:
+            force_prev = math.nan
+        self._force_at = None
         while True:
             row = self.row
             if journal:
@@ -643,10 +657,12 @@ class _TimeStepped:
                 dt,
                 self._max_substep,
                 self._max_edge_cells * row.dx,
+                force_prev,
             )
             journal = False
             if status == _kernels.STATUS_OK:
                 break
+            force_prev = math.nan  # a new row after the growth
             if start is None:
                 _kernels._restore_state(row.wl, row.wsum, row.wb, row.bsum, row.txn, row.txn_b)
             else:
@@ -661,6 +677,7 @@ class _TimeStepped:
         self._memory_peak = peak
         self._edge = (outside, inside, g_edge)
         self._edge_depth = d1
+        self._force_at = (row, radius, d1, force)
         if row is not self._prepare_row:
             self._prepare_row = row
             self._prepare_radius = PREPARE_FRACTION * row.length
@@ -679,6 +696,7 @@ class _TimeStepped:
         either."""
         n = times.size
         rows = np.zeros((n, _kernels.ROW_SIZE))
+        self._force_at = None
         t_prev, d_prev = sim.time, sim._depth
         radius = sim.output.contact_radius
         i = 0
@@ -787,13 +805,22 @@ class _TimeStepped:
         self.dissipated = dissipated
         self._memory_peak = None
         self._edge_depth = math.nan
+        self._force_at = None
 
     def begin(self) -> tuple:
         """Start a transaction (`ContactSimulator.step`): a token of the scalars; the memory
         is journalled by the first kernel call (`advance`), so a step that succeeds copies
         nothing but that."""
         self._journal = None
-        return (self.radius, self.row, self.dissipated, self._memory_peak, self._edge, self._edge_depth)
+        return (
+            self.radius,
+            self.row,
+            self.dissipated,
+            self._memory_peak,
+            self._edge,
+            self._edge_depth,
+            self._force_at,
+        )
 
     def rollback(self, token: tuple) -> None:
         """Undo everything since `begin` returned `token`."""
@@ -803,7 +830,16 @@ class _TimeStepped:
                 journal.wl, journal.wsum, journal.wb, journal.bsum, journal.txn, journal.txn_b
             )
             self._journal = None
-        self.radius, self.row, self.dissipated, self._memory_peak, self._edge, self._edge_depth = token
+        # The memory is back to the transaction's start, so is the force known on it.
+        (
+            self.radius,
+            self.row,
+            self.dissipated,
+            self._memory_peak,
+            self._edge,
+            self._edge_depth,
+            self._force_at,
+        ) = token
 
     def is_relaxed(self) -> bool:
         if self.row is None:
@@ -819,6 +855,7 @@ class _TimeStepped:
         """Forget a relaxed, out-of-contact state: the next contact sizes a fresh domain."""
         self.row = None
         self._memory_peak = None
+        self._force_at = None
 
     def get_state(self) -> tuple:
         if self.row is None:
@@ -831,6 +868,7 @@ class _TimeStepped:
         self.dissipated = dissipated
         self._memory_peak = None
         self._edge_depth = math.nan
+        self._force_at = None
         if row is None:
             self.row = None
         elif row is self.row:
@@ -847,6 +885,7 @@ class _TimeStepped:
         self._memory_peak = None
         self._journal = None
         self._edge_depth = math.nan
+        self._force_at = None
 
 
 def _phase(model: Any, physics: _Physics, depth: float, r0: float, radius: float, g_edge: float) -> Phase:

@@ -1,0 +1,43 @@
+"""The K = 1 update's running sums in four lanes (0.4.0, `elem`, `_kernels._sum_losses`)
+against the in-order loop they replaced (kept here as a test-only reference): the losses' sum
+moves by rounding only (a few N eps of it, still >= 0), the memory peak not at all (a maximum
+is the same in any order). tests/golden_tolerance.py says why that rounding is allowed;
+tests/test_kernel_golden.py compares whole scenes."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from viscoadh_ros.core import _kernels
+
+EPS = np.finfo(float).eps
+
+
+def _in_order_losses(diss, wsum, lo, hi, total, peak):
+    """The 0.3.0 loop of `_update_range_one`: one chain in index order."""
+    for i in range(lo, hi):
+        total += diss[i]
+        peak = max(peak, abs(wsum[i]))
+    return total, peak
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_the_losses_and_the_peak_in_four_lanes(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    for _ in range(200):
+        n = int(rng.integers(1, 80))
+        diss = rng.exponential(1e-9, n) * (rng.uniform(size=n) < 0.9)
+        wsum = rng.normal(0.0, 1e-6, n)
+        lo = int(rng.integers(0, n))
+        hi = int(rng.integers(lo, n + 1))
+        total0, peak0 = float(rng.exponential(1e-8)), float(rng.exponential(1e-7))
+        total, peak = _kernels._sum_losses(diss, wsum, lo, hi, total0, peak0)
+        want_total, want_peak = _in_order_losses(diss, wsum, lo, hi, total0, peak0)
+        assert peak == want_peak  # exact: a maximum in any order
+        exact = math.fsum([total0, *diss[lo:hi]])
+        assert total >= 0.0
+        assert abs(total - exact) <= 2.0 * (hi - lo + 2) * EPS * exact
+        assert abs(want_total - exact) <= 2.0 * (hi - lo + 2) * EPS * exact
