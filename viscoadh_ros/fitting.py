@@ -514,6 +514,70 @@ def _widen(keep: NDArray[np.bool_], fraction: float) -> NDArray[np.bool_]:
     return keep & ~near
 
 
+def coarse_record(experiment: Experiment, picked: NDArray[np.bool_], every: int) -> Experiment:
+    """The coarse stage's record: the ``picked`` measured samples only, and the inputs the
+    model needs to reach them (the last input at or before each, the first and the last one,
+    and every ``every``-th input across the gaps between them, e.g. the masked jumps). The
+    model then steps once per kept stamp instead of once per input: on a dense input stream
+    each kept input ramps (first-order hold) from the last kept one, the same piecewise-linear
+    path at a coarser time step. A record the thinning cannot keep faithful (restarts,
+    recording order, force inputs, inputs out of stamp order) or ``every <= 1`` is returned as
+    it is."""
+    if (
+        every <= 1
+        or experiment.restarts
+        or experiment.by_arrival
+        or np.any(experiment.input_mode != DEPTH)
+        or np.any(np.diff(experiment.input_ns) < 0)
+    ):
+        return experiment
+    n = experiment.input_ns.size
+    at = np.searchsorted(experiment.input_ns, experiment.measured_ns[picked], side="right") - 1
+    kept = np.unique(np.concatenate(([0, n - 1], at[at >= 0])))
+    gaps = np.flatnonzero(np.diff(kept) > every)
+    if gaps.size:
+        fill = [np.arange(kept[g] + every, kept[g + 1], every) for g in gaps]
+        kept = np.unique(np.concatenate([kept, *fill]))
+    if kept.size >= n:
+        return experiment
+    return dataclasses.replace(
+        experiment,
+        input_ns=experiment.input_ns[kept],
+        input_order=experiment.input_order[kept],
+        input_mode=experiment.input_mode[kept],
+        input_value=experiment.input_value[kept],
+        input_index=None if experiment.input_index is None else experiment.input_index[kept],
+        measured_ns=experiment.measured_ns[picked],
+        measured_force=experiment.measured_force[picked],
+        measured_order=experiment.measured_order[picked],
+        rejected_index=np.empty(0, dtype=np.int64),
+        rejected_reason=(),
+    )
+
+
+def by_retardation(values: dict[str, float], kelvin: int) -> dict[str, float]:
+    """``values`` with the Kelvin elements relabelled in ascending retardation time
+    ``eta_k / G_k`` (the chain's force does not depend on the order of its elements)."""
+    order = sorted(range(1, kelvin + 1), key=lambda k: values[f"eta{k}"] / values[f"G{k}"])
+    relabelled = dict(values)
+    for k, old in enumerate(order, start=1):
+        relabelled[f"G{k}"], relabelled[f"eta{k}"] = values[f"G{old}"], values[f"eta{old}"]
+    return relabelled
+
+
+def _ordered(
+    problem: _Problem, u: NDArray[np.float64], lower: NDArray[np.float64], upper: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """``u`` with the chain's elements in ascending retardation time when that point lies in the
+    box (the same force: the fit lands on either labelling of a valley it finds); else ``u``."""
+    values = problem.values(u)
+    relabelled = by_retardation(values, problem.kelvin)
+    if relabelled == values:
+        return u
+    swapped = np.array([math.log(relabelled[n] / problem.start[n]) for n in problem.free])
+    return swapped if np.all((swapped >= lower) & (swapped <= upper)) else u
+
+
 def polish_elements(contact: ContactConfig, noise: float, force_scale: float, coarse: int) -> int:
     """Elements of the polish's grid: the element count `numerics_for_tolerance` chooses for a
     model error of MODEL_ERROR_FRACTION of ``noise / force_scale`` (``force_scale`` the
@@ -720,9 +784,15 @@ def fit(
     if experiment.measured_force.size < 5:
         raise FitError(f"{experiment.measured_force.size} force samples cannot fit {len(free)} parameters")
     start = initial_values(contact, kelvin)
+    chain = [f"{g}{k}" for g in ("G", "eta") for k in range(1, kelvin + 1)]
+    # Every element free: the chain's labels are a convention, ascending retardation time (the
+    # start's too, so each element's box is centred on the like element of the start).
+    ordered = kelvin > 1 and all(name in free for name in chain)
     for name in free:
         if not start[name] > 0.0 or not math.isfinite(start[name]):
             raise InputError(f"start value of {name} must be finite and > 0 (got {start[name]})")
+    if ordered:
+        start = by_retardation(start, kelvin)
     noise = _noise_floor(experiment.measured_force)
     depth = np.interp(
         experiment.time(experiment.measured_ns), experiment.time(experiment.input_ns), experiment.input_value
@@ -755,7 +825,10 @@ def fit(
     thin = max(1, math.ceil(int(np.count_nonzero(coarse_used)) / COARSE_SAMPLES))
     picked = np.zeros_like(used)
     picked[np.flatnonzero(coarse_used)[::thin]] = True
-    problem = coarse = _Problem(grid_contact, experiment, free, kelvin, start, picked, noise)
+    thinned = coarse_record(experiment, picked, thin)
+    if thinned is not experiment:
+        picked = np.ones(thinned.measured_force.size, dtype=bool)
+    problem = coarse = _Problem(grid_contact, thinned, free, kelvin, start, picked, noise)
     step = _difference_step(problem, np.zeros(p))
 
     def descend(u0: NDArray[np.float64]) -> tuple[NDArray[np.float64], float]:
@@ -787,6 +860,8 @@ def fit(
     explored = noisy(2.0 * best, max(coarse.measured.size - p, 1))
     if explored:
         u, best = explore(u, best)
+    if ordered:
+        u = _ordered(coarse, u, lower, upper)
 
     # Polish on the secant model on every used sample and the grid whose model error sits
     # below the noise, then again on grids refined by 2 until the optimum stops moving: the
@@ -809,6 +884,8 @@ def fit(
         # test is sqrt(k) looser): a local valley; the global stage decides after all.
         runs, spent = coarse.runs, coarse.model_time
         found, _ = explore(polished.u, cost(polished.u))
+        if ordered:
+            found = _ordered(coarse, found, lower, upper)
         problem.runs, model_time = problem.runs + coarse.runs - runs, model_time + coarse.model_time - spent
         if found is not polished.u:
             other = _polish(problem, found, lower, upper, smallest)
