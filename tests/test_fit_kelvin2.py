@@ -21,8 +21,8 @@ import numpy as np
 from fit_records import DEPTH_TOPIC, scene, standard_history, true_force, write_record
 
 from viscoadh_ros.bench.fit_speed import KELVIN2
-from viscoadh_ros.experiment import load_experiment
-from viscoadh_ros.fitting import fit
+from viscoadh_ros.experiment import load_experiment, run_model
+from viscoadh_ros.fitting import by_retardation, coarse_record, fit
 from viscoadh_ros.io.bag import Bag
 
 SAMPLES = 5000
@@ -46,3 +46,33 @@ def test_a_two_element_chain_from_a_start_off_by_three_finds_the_truth(tmp_path)
         assert abs(math.log(value / truth)) < 0.05, f"{name}: {value:g} vs truth {truth:g}"
         lo, hi = result.interval[name]
         assert lo <= truth <= hi, f"{name}: truth {truth:g} outside the stated 95 % interval {lo:g}..{hi:g}"
+
+
+def test_the_coarse_record_runs_the_same_model_on_fewer_stamps(tmp_path) -> None:
+    """`coarse_record` keeps the picked samples and the inputs that reach them: the model's force
+    there stays within a fraction of the noise of the full record's (the first-order hold ramps
+    over the kept inputs as over the dense ones), while the model steps a third as often."""
+    path = tmp_path / "thin.mcap"
+    time, depth = standard_history(3000)
+    force = true_force(KELVIN2, time, depth, kelvin=2)
+    sigma = write_record(path, time, depth, force, noise=0.01, seed=2)
+    record = load_experiment(Bag(path), input_topic=DEPTH_TOPIC)
+    picked = np.zeros(record.measured_force.size, dtype=bool)
+    picked[7::3] = True
+    thinned = coarse_record(record, picked, 3)
+    assert thinned.measured_force.size == int(np.count_nonzero(picked))
+    assert np.array_equal(thinned.measured_ns, record.measured_ns[picked])
+    assert thinned.input_ns.size < 0.4 * record.input_ns.size
+    contact = scene(KELVIN2, kelvin=2).contacts[0]
+    full = run_model(contact, record).model_force[picked]
+    thin = run_model(contact, thinned).model_force
+    assert float(np.max(np.abs(thin - full))) < 0.5 * sigma, float(np.max(np.abs(thin - full))) / sigma
+    # Nothing to thin: the record itself.
+    assert coarse_record(record, picked, 1) is record
+
+
+def test_a_free_chain_is_labelled_by_retardation_time() -> None:
+    swapped = {**KELVIN2, "G1": KELVIN2["G2"], "eta1": KELVIN2["eta2"], "G2": 1.0e5, "eta2": 1.0e2}
+    relabelled = by_retardation(swapped, 2)
+    assert relabelled == {**KELVIN2, "G1": 1.0e5, "eta1": 1.0e2, "G2": KELVIN2["G2"], "eta2": KELVIN2["eta2"]}
+    assert by_retardation(KELVIN2, 2) == KELVIN2
