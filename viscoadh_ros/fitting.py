@@ -934,8 +934,8 @@ def fit(
     if explored:
         u, best = explore(u, best)
     if ordered:
-        u = _ordered(coarse, u, lower, upper)
-        u, best = _retardation_scan(coarse, u, best, lower, upper, descend)
+        u, best = _retardation_scan(coarse, _ordered(coarse, u, lower, upper), best, lower, upper, descend)
+        u = _ordered(coarse, u, lower, upper)  # a scan's move may pass one time over another
 
     # Polish on the secant model on every used sample and the grid whose model error sits
     # below the noise, then again on grids refined by 2 until the optimum stops moving: the
