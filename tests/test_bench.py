@@ -89,6 +89,9 @@ def test_kernel_row_is_well_formed(kelvin: int) -> None:
             row[ratio], row[over] / row[under], rtol=1e-12, err_msg=f"{ratio} of K={kelvin}"
         )
     assert row["substeps_per_step"] >= 1.0
+    # The timed cycle is what the section says it is: ordinary in-contact steps (0.4.0: a K = 1
+    # body let go of the indenter before the hold, and the cycle timed the re-contact).
+    assert row["in_contact"] == 1.0, row
     # The minimal stepper computes the same model: its pull-off within a few percent even at
     # 32 elements (a baseline that computed something else would show here).
     assert row["pull_off_rel_diff"] < 0.05, row
