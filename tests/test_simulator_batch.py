@@ -96,3 +96,19 @@ def test_step_depths_bad_input_changes_nothing(time, depth, message) -> None:
     with pytest.raises(InputError, match=message):
         sim.step_depths(np.array(time) + 0.2, np.array(depth))
     assert sim.output == before
+
+
+@pytest.mark.parametrize("kelvin", [False, True])
+def test_phase_at_rest_of_a_batch_that_ends_out_of_contact(kelvin: bool) -> None:
+    """An edge held at rest reads the same phase in a batch as step by step, also when the
+    batch ends out of contact with its domain dropped (0.4.0, an outside tester: the batch took
+    its at-rest threshold from the row left after it, none, and read the held edge INDENTING
+    and DETACHING in turn). Time-stepped path (`model: time_stepped`), elastic and creeping."""
+    contact = _sphere({"model": "time_stepped", "elements": 64}, kelvin=kelvin)
+    times = np.arange(1, 41) * 1e-3
+    depths = np.concatenate([[40e-6], np.full(19, 80e-6), np.full(20, -2e-3)])
+    sim = ContactSimulator(contact)
+    per_call = [sim.step(float(t), depth=float(d)).phase for t, d in zip(times, depths, strict=True)]
+    batch = ContactSimulator(contact).step_depths(times, depths)
+    assert [int(p) for p in per_call] == [int(p) for p in batch["phase"]]
+    assert batch["contact_radius"][-1] == 0.0

@@ -687,15 +687,17 @@ class _TimeStepped:
 
     def advance_rows(
         self, sim: ContactSimulator, times: np.ndarray, depths: np.ndarray
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Advance through a depth history from ``sim``'s time and depth as `sim._trial`
         then `advance` would row by row; returns per row (radius m, force N, work J, energy
         dissipated since the last reset J, edge gaps and g at the edge (n, 3) m: exterior
-        memory, interior memory, profile).
+        memory, interior memory, profile, and the `edge_resolution` of the row that stepped
+        it, m: what `step` reads after the same step; 0 for a row without a domain).
         Rows without a row (no domain yet, or idle above the surface) cost nothing here
         either."""
         n = times.size
         rows = np.zeros((n, _kernels.ROW_SIZE))
+        resolution = np.zeros(n)
         self._force_at = None
         t_prev, d_prev = sim.time, sim._depth
         radius = sim.output.contact_radius
@@ -716,6 +718,7 @@ class _TimeStepped:
             if peak is None:
                 peak = float(np.max(np.abs(row.wsum), initial=0.0))
             backup = np.empty_like(row.wl)
+            first = i
             i, status = _kernels._advance_rows(
                 *row.kernel_args,
                 backup,
@@ -732,6 +735,7 @@ class _TimeStepped:
                 self.numerics.idle_tolerance * row.length,
                 rows,
             )
+            resolution[first:i] = self.edge_resolution
             if i > 0:
                 last = rows[i - 1]
                 radius = float(last[_kernels.OUT_RADIUS])
@@ -752,6 +756,7 @@ class _TimeStepped:
             out[:, _kernels.OUT_WORK].copy(),
             dissipated,
             rows[:, _kernels.OUT_GAP_OUTSIDE : _kernels.OUT_G_EDGE + 1].copy(),
+            resolution,
         )
 
     def stored_energy(self, depth: float) -> float:
@@ -1288,12 +1293,14 @@ class ContactSimulator:
         if t.size == 0:
             return _empty_columns()
         if isinstance(self._model, _TimeStepped):
-            radius, force, work, dissipated, gaps = self._model.advance_rows(self, t, d)
+            radius, force, work, dissipated, gaps, rest = self._model.advance_rows(self, t, d)
         else:
             outputs = [self._step(float(ti), float(di), None) for ti, di in zip(t, d, strict=True)]
             return _columns(outputs)
         physics = self.physics
-        rest = self._model.edge_resolution  # the row after the batch (growth only widens it)
+        # `rest`: per row, the edge resolution of the row that stepped it (the row after the
+        # batch may be another one, or none: a batch that ended idle read every edge at rest
+        # as moving, INDENTING and DETACHING in turn).
         r0 = np.concatenate(([self._output.contact_radius], radius[:-1]))
         dt = np.diff(t, prepend=self._time)
         energy_input = np.cumsum(np.concatenate(([self._energy_input], work)))[1:]
