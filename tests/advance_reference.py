@@ -2,7 +2,8 @@
 as a test-only reference: every accepted substep updates the whole row and computes the force
 over the whole interior. `tests/test_deferred_substeps.py` compares the product's deferred
 substeps (O(window) per accepted substep) with it. The body is main's at 7bcb817
-(the snap-in located in time, before the deferral), renamed;
+(the snap-in located in time, before the deferral), renamed, with
+the attempt guard that grows with the row (0.4.0) as the product's;
 it calls the product's per-element kernels, which the deferral does not touch.
 """
 
@@ -13,6 +14,7 @@ import math
 import numba
 
 from viscoadh_ros.core._kernels import (
+    _ATTEMPTS_PER_ELEMENT,
     _MAX_ATTEMPTS,
     _MAX_TOUCH_PLANS,
     JUMP_RESOLUTION,
@@ -184,7 +186,7 @@ def advance_from_reference(
         da = d0 + (d1 - d0) * (tau / dt)
         db = d1 if last else d0 + (d1 - d0) * ((tau + h) / dt)
         n_in = _interior_count(a, dx, n)
-        limited = h > h_min and attempts + 1 < _MAX_ATTEMPTS
+        limited = h > h_min and attempts + 1 < _MAX_ATTEMPTS + _ATTEMPTS_PER_ELEMENT * n
         lo, hi = 0, n
         slope = (db - da) / h
         if k_count:

@@ -84,9 +84,15 @@ ROW_GAP_INSIDE = OUT_GAP_INSIDE
 ROW_SIZE = OUT_SIZE
 
 # Substep attempts per `advance` after which the edge-motion limit is dropped for the rest of
-# the step: a guard (never reached in the test suite) so that an edge criterion flipping back
-# and forth at any step size cannot stall a node; the step still completes exactly in time.
+# the step: a guard so that an edge criterion flipping back and forth at any step size cannot
+# stall a node; the step still completes exactly in time. It grows with the row
+# (`_MAX_ATTEMPTS + _ATTEMPTS_PER_ELEMENT * N`): an edge that sweeps the whole row in one step
+# needs about two attempts per element it crosses (one accepted, one rejected doubling), and
+# with a flat 2000 a fine row (1024+ elements, e.g. from `numerics.tolerance`) ran out of
+# attempts in a fast pull-off, crossed the rest in one substep and dissipated ten times the work
+# put in (0.4.0, an outside tester).
 _MAX_ATTEMPTS = 2000
+_ATTEMPTS_PER_ELEMENT = 4
 
 # Below this |lambda dt| the phi functions use their Taylor series: the closed forms lose
 # all digits to cancellation there (1 - exp(-x) for x ~ 1e-12).
@@ -1808,7 +1814,7 @@ def _advance_from(
         da = d0 + (d1 - d0) * (tau / dt)
         db = d1 if last else d0 + (d1 - d0) * ((tau + h) / dt)
         n_in = _interior_count(a, dx, n)
-        limited = h > h_min and attempts + 1 < _MAX_ATTEMPTS
+        limited = h > h_min and attempts + 1 < _MAX_ATTEMPTS + _ATTEMPTS_PER_ELEMENT * n
         lo, hi = 0, n
         slope = (db - da) / h
         if k_count:
