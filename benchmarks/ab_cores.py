@@ -1,4 +1,5 @@
-"""Two checkouts' cores in one process for the side-by-side benchmarks (bound_ab.py, snap_ab.py).
+"""Two checkouts' cores in one process for the side-by-side benchmarks (bound_ab.py, snap_ab.py,
+kernel_module_ab.py).
 
 Importing the old checkout's package in place would give its compiled kernels the same
 module name, ``viscoadh_ros.core._kernels``, hence the same symbol names as this checkout's:
@@ -19,7 +20,9 @@ from pathlib import Path
 from types import ModuleType
 
 
-def _renamed_kernels(root: str) -> ModuleType:
+def renamed_kernels(root: str) -> ModuleType:
+    """The kernel module of the checkout at `root`, compiled from a copy named by its content hash
+    (its own numba cache and symbols; see the module docstring)."""
     source = (Path(root) / "viscoadh_ros/core/_kernels.py").read_bytes()
     digest = hashlib.sha256(source).hexdigest()[:16]
     folder = Path(tempfile.gettempdir()) / f"viscoadh_kernels_ab_{digest}"
@@ -46,7 +49,7 @@ def load(root: str, *, rename_kernels: bool) -> dict[str, ModuleType]:
         import viscoadh_ros.core  # noqa: F401  (the package, before its kernel module)
 
         if rename_kernels:
-            kernels = _renamed_kernels(root)
+            kernels = renamed_kernels(root)
             sys.modules["viscoadh_ros.core._kernels"] = kernels
             sys.modules["viscoadh_ros.core"]._kernels = kernels  # type: ignore[attr-defined]
         from viscoadh_ros.bench import kernel as bench_kernel

@@ -18,10 +18,7 @@ Only ratios from one sitting count (shared machine).
 
 from __future__ import annotations
 
-import hashlib
-import importlib.util
 import sys
-import tempfile
 import time
 from pathlib import Path
 
@@ -34,30 +31,10 @@ from viscoadh_ros.bench.reference_stepper import MinimalStepper
 from viscoadh_ros.core import _kernels as new
 from viscoadh_ros.core.simulator import ContactSimulator
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from ab_cores import renamed_kernels  # noqa: E402
+
 STEPS = 400
-
-
-def _old_module(root: str):
-    """The old checkout's kernel module, compiled under its own name from a private copy.
-
-    Loading the old file in place would take its compiled functions from that checkout's
-    numba cache, written under the module name ``viscoadh_ros.core._kernels``: the same
-    symbol names as this checkout's functions, so in one process the old kernels could call
-    the new callees (seen with the 0.3.0 edge root finder: "old" rows equal to the new ones).
-    A copy named by its content hash gets its own cache under its own module name."""
-    source = (Path(root) / "viscoadh_ros/core/_kernels.py").read_bytes()
-    digest = hashlib.sha256(source).hexdigest()[:16]
-    folder = Path(tempfile.gettempdir()) / f"viscoadh_kernels_ab_{digest}"
-    folder.mkdir(exist_ok=True)
-    path = folder / f"kernels_old_{digest}.py"
-    if not path.exists() or path.read_bytes() != source:
-        path.write_bytes(source)
-    spec = importlib.util.spec_from_file_location(f"kernels_old_{digest}", path)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module  # the cache's environments import it by name
-    spec.loader.exec_module(module)
-    return module
 
 
 def _setup(elements: int, kelvin: int) -> tuple[ContactSimulator, np.ndarray]:
@@ -216,7 +193,9 @@ def main() -> None:
         global STEPS
         STEPS = int(args[at + 1])
         del args[at : at + 2]
-    old = _old_module(args[0])
+    # Under its own module name: loaded in place it would share the new kernels' compiled symbols
+    # (seen with the 0.3.0 edge root finder: "old" rows equal to the new ones).
+    old = renamed_kernels(args[0])
     for spec in args[1:]:
         elements, kelvin = (int(v) for v in spec.split(","))
         us = measure(old, elements, kelvin, close)
