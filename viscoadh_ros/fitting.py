@@ -55,12 +55,15 @@ How it finds the optimum from a poor start (issue 12):
    reported as not converged, never as a success.
 5. **Intervals**: linearised from the secant Jacobian, ``cov = s^2 (J^T J)^-1`` with the
    residual variance ``s^2``, widened where the cost along a parameter's profile direction
-   rises less than the linear model says (:func:`_profile_inflation`, never narrowed), plus
+   rises less than the linear model says, each side on its own (:func:`_profile_inflation`,
+   never narrowed: a valley steep on one side and flat on the other bounds the parameter on
+   one side only, and the mean of the two sides would read it as identified), plus
    a model-error term for the discretisation: the shift of the optimum that refining the
    grid (twice the elements) would cause (its Gauss-Newton step from one model run on the
    refined grid against the polish's Jacobian), added in quadrature.
-   The 95 % interval is ``u +- 1.96 sigma_u`` (asymmetric in the parameter). Their coverage is
-   tested on seeded synthetic records (tests/test_fit_coverage.py).
+   The 95 % interval is ``u - 1.96 sigma_low .. u + 1.96 sigma_high`` (asymmetric in the
+   parameter, and in u where the profile is); the stated standard deviation is the mean of
+   the two. Their coverage is tested on seeded synthetic records (tests/test_fit_coverage.py).
 
 A parameter the record cannot identify (no dependence, a flat valley with another one, or a
 relative standard deviation above :data:`MAX_RELATIVE_UNCERTAINTY`) is reported as not
@@ -109,8 +112,8 @@ SECANT_SIGMAS = 3.0
 #: deviations are small), narrow against the curvature (its bias ~ width^2 is ~1e-5 here).
 MIN_SECANT = 5e-3
 #: The profile check of the intervals: the cost at this many standard deviations along each
-#: parameter's profile direction; a mean rise below this fraction of the linear model's widens
-#: the interval (`_profile_inflation`).
+#: parameter's profile direction, each side; a rise below this fraction of the linear model's
+#: widens the interval on that side (`_profile_inflation`).
 PROFILE_SIGMAS = 3.0
 PROFILE_TRUST = 0.25
 #: Default half-width of the search box: each free parameter within start/10 .. start*10.
@@ -803,37 +806,38 @@ def _polish(
 def _profile_inflation(
     problem: _Problem, polished: _Polished, lower: NDArray[np.float64], upper: NDArray[np.float64]
 ) -> NDArray[np.float64]:
-    """Factor (>= 1) on each linearised standard deviation from the cost itself: along the
-    profile direction of parameter j (``cov[:, j] / sigma_j``: u_j moves, the others follow
-    its valley) the linear model predicts a rise of ``(k s)^2`` at ``k = PROFILE_SIGMAS``
-    standard deviations either side. Where the mean measured rise is below PROFILE_TRUST of
-    that (on long records the secant reads the model's roughness, single samples flipping as
-    element events cross stamps, as slope, and the valley is wider than it says) it is
-    measured again that much wider and the deviation scaled to what the cost shows. 4p model
-    runs at most."""
+    """Factors (>= 1) on each linearised standard deviation from the cost itself, one for each
+    side: row 0 below the optimum, row 1 above. Along the profile direction of parameter j
+    (``cov[:, j] / sigma_j``: u_j moves, the others follow its valley) the linear model
+    predicts a rise of ``(k s)^2`` at ``k = PROFILE_SIGMAS`` standard deviations on each side.
+    Where a side's measured rise is below PROFILE_TRUST of that (on long records the secant
+    reads the model's roughness, single samples flipping as element events cross stamps, as
+    slope, and the valley is wider than it says; a parameter the record bounds on one side only
+    has a valley that is steep on that side and flat on the other) that side is measured again
+    that much wider and its deviation scaled to what the cost shows. Each side on its own: the
+    mean of the two sides reads a one-sided valley as a two-sided one (a confident 26 % on a
+    viscosity the record only bounds from above, tests/test_fit_cli.py). 4p model runs at most."""
     u, cov, r = polished.u, polished.cov, polished.r
     dof = max(r.size - u.size, 1)
     s2 = float(r @ r) / dof
     base = float(r @ r)
-    factors = np.ones(u.size)
+    factors = np.ones((2, u.size))
     for j in range(u.size):
         sigma = math.sqrt(cov[j, j]) if math.isfinite(cov[j, j]) else math.inf
         if not math.isfinite(sigma) or sigma <= 0.0 or not np.all(np.isfinite(cov[:, j])):
             continue
         direction = cov[:, j] / sigma
-        k = PROFILE_SIGMAS
-        for _ in range(2):
-            rises = []
-            for sign in (1.0, -1.0):
+        for side, sign in enumerate((-1.0, 1.0)):
+            k = PROFILE_SIGMAS
+            for _ in range(2):
                 trial = np.clip(u + sign * k * direction, lower, upper)
                 rt = problem.residual(trial)
-                rises.append(float(rt @ rt) - base)
-            rise = max(float(np.mean(rises)), 1e-2 * s2)
-            expected = (k / factors[j]) ** 2 * s2  # k in the inflated deviations so far
-            if rise >= PROFILE_TRUST * expected:
-                break
-            factors[j] *= math.sqrt(expected / rise)
-            k = PROFILE_SIGMAS * factors[j]
+                rise = max(float(rt @ rt) - base, 1e-2 * s2)
+                expected = (k / factors[side, j]) ** 2 * s2  # k in the inflated deviations so far
+                if rise >= PROFILE_TRUST * expected:
+                    break
+                factors[side, j] *= math.sqrt(expected / rise)
+                k = PROFILE_SIGMAS * factors[side, j]
     return factors
 
 
@@ -994,15 +998,16 @@ def fit(
             f"{sigmas[worst]:.1f} standard deviations in {free[worst]}"
         )
     inflation = _profile_inflation(problem, polished, lower, upper)
-    sigma_u = np.sqrt(np.diag(cov) * inflation**2 + shift**2)
+    sigma_low, sigma_high = np.sqrt(np.diag(cov) * inflation**2 + shift**2)
 
     values = problem.values(u)
     uncertainty, interval, identified = {}, {}, {}
     for j, name in enumerate(free):
-        s = float(sigma_u[j])
-        identified[name] = name not in flat and s <= MAX_RELATIVE_UNCERTAINTY
-        lo = max(u[j] - Z95 * s, -half) if math.isfinite(s) else -half
-        hi = min(u[j] + Z95 * s, half) if math.isfinite(s) else half
+        s_low, s_high = float(sigma_low[j]), float(sigma_high[j])
+        s = 0.5 * (s_low + s_high)
+        identified[name] = name not in flat and max(s_low, s_high) <= MAX_RELATIVE_UNCERTAINTY
+        lo = max(u[j] - Z95 * s_low, -half) if math.isfinite(s_low) else -half
+        hi = min(u[j] + Z95 * s_high, half) if math.isfinite(s_high) else half
         interval[name] = (start[name] * math.exp(lo), start[name] * math.exp(hi))
         uncertainty[name] = values[name] * s if math.isfinite(s) else math.inf
     unidentified = [n for n in free if not identified[n]]
