@@ -1,0 +1,57 @@
+"""A node log where contact c0 was driven partly by HandCommand (hand/indentation) and partly by
+c0/indentation. Docs: replay does not read hand commands yet. What does `viscoadh replay
+--contact c0` say about such a log: a clear refusal or warning, or a silent wrong replay?"""
+
+import time
+
+import rclpy
+from builtin_interfaces.msg import Time
+from rclpy.node import Node
+from rosgraph_msgs.msg import Clock
+from viscoadh_msgs.msg import ContactState, HandCommand, HandState, IndentationCommand
+
+rclpy.init()
+node = Node("tester5_handlog")
+clock_pub = node.create_publisher(Clock, "/clock", 10)
+pub = node.create_publisher(IndentationCommand, "c0/indentation", 100)
+hand = node.create_publisher(HandCommand, "hand/indentation", 100)
+states, hstates = [], []
+node.create_subscription(ContactState, "c0/state", states.append, 1000)
+node.create_subscription(HandState, "hand/state", hstates.append, 1000)
+base = 50 * 10**9
+
+
+def T(ns):
+    return Time(sec=ns // 10**9, nanosec=ns % 10**9)
+
+
+def spin(pred, timeout=2.0):
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        rclpy.spin_once(node, timeout_sec=0.01)
+        if pred():
+            return
+
+
+while pub.get_subscription_count() == 0 or hand.get_subscription_count() == 0:
+    clock_pub.publish(Clock(clock=T(base)))
+    spin(lambda: False, 0.1)
+clock_pub.publish(Clock(clock=T(base)))
+spin(lambda: False, 0.2)
+for i in range(1, 301):
+    ns = base + i * 10**6
+    if 100 < i <= 200:  # the middle third by hand commands
+        m = HandCommand(contact_ids=["c0", "c1"], mode=0, depth=[i * 0.1e-6, 5e-6])
+        m.header.stamp = T(ns)
+        n = len(hstates)
+        hand.publish(m)
+        spin(lambda: len(hstates) > n)
+    else:
+        m = IndentationCommand(mode=0, depth=(i if i <= 100 else 400 - i) * 0.1e-6)
+        m.header.stamp = T(ns)
+        n = len(states)
+        pub.publish(m)
+        spin(lambda: len(states) > n)
+print(f"c0 states {len(states)}, hand states {len(hstates)}")
+node.destroy_node()
+rclpy.shutdown()
