@@ -93,3 +93,40 @@ def test_an_exception_inside_the_model_restores_the_state(monkeypatch: pytest.Mo
         live.advance(live.time + 0.2)
     monkeypatch.undo()
     _assert_same(live, twin, "interrupted step")
+
+
+@pytest.mark.parametrize(
+    "other",
+    [
+        {"finger.numerics.preset": "balanced"},  # another grid
+        {"finger.adhesion.work_of_adhesion": 0.5},
+        {
+            "finger.material.kelvin_shear_moduli": [2.0e5, 1.0e5],
+            "finger.material.kelvin_viscosities": [2.0e3, 1e5],
+        },
+        {
+            "finger.material.kelvin_shear_moduli": [],
+            "finger.material.kelvin_viscosities": [],
+            "finger.numerics.model": "auto",
+        },
+    ],
+    ids=["numerics", "adhesion", "kelvin-2", "closed-form"],
+)
+def test_a_snapshot_of_another_contact_is_refused_and_changes_nothing(other: dict[str, Any]) -> None:
+    """Found by an outside tester (benchmarks/outside_test_0.5.0/core_snapshot_mismatch.py): a
+    snapshot restored into another contact's simulator ran the snapshot's memory under the other
+    physics (or failed with a TypeError on the closed form)."""
+    source, _ = _twins()
+    _pressed(source)
+    snapshot = source.snapshot()
+    contact = SceneConfig.from_parameters({**SCENE, **other}).contact("finger")
+    live, twin = ContactSimulator(contact), ContactSimulator(contact)
+    _pressed(live)
+    _pressed(twin)
+    with pytest.raises(InputError, match="another contact"):
+        live.restore(snapshot)
+    _assert_same(live, twin, "a refused restore")
+    # The same contact, in a new simulator: accepted, and it continues as the source does.
+    same, _ = _twins()
+    same.restore(snapshot)
+    _assert_same(same, source, "a restore into the same contact")

@@ -1000,7 +1000,8 @@ def _modal_chain(e0: float, e_kelvin: np.ndarray, eta_kelvin: np.ndarray) -> tup
 
 @dataclass(frozen=True)
 class Snapshot:
-    """An opaque copy of a simulator's state (see `ContactSimulator.snapshot`)."""
+    """An opaque copy of a simulator's state (see `ContactSimulator.snapshot`); it restores
+    into a simulator of the same contact (an equal ContactConfig) only."""
 
     model_state: Any
     time: float
@@ -1009,6 +1010,7 @@ class Snapshot:
     energy_input: float
     held_force: float | None
     force_memo: Any = None
+    contact: Any = None  # the ContactConfig it was taken of
 
 
 class ContactSimulator:
@@ -1106,9 +1108,21 @@ class ContactSimulator:
             self._energy_input,
             self._held_force,
             self._force_memo,
+            self.contact,
         )
 
     def restore(self, snapshot: Snapshot) -> None:
+        """Back to the state `snapshot` holds. A snapshot of another contact (a different
+        ContactConfig: material, indenter, adhesion or numerics) is refused with an InputError
+        and changes nothing: its memory means nothing under other physics or another grid."""
+        if not isinstance(snapshot, Snapshot):
+            raise InputError(f"restore needs a Snapshot (got {type(snapshot).__name__})")
+        theirs = snapshot.contact
+        if theirs is not None and theirs is not self.contact and theirs != self.contact:
+            raise InputError(
+                "this snapshot was taken of another contact (its material, indenter, adhesion or "
+                "numerics differ): restore it into a simulator of the same contact"
+            )
         self._model.set_state(snapshot.model_state)
         self._time = snapshot.time
         self._depth = snapshot.depth
