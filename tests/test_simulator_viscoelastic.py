@@ -199,6 +199,32 @@ def test_predict_pull_off_leaves_the_live_state_alone() -> None:
         predict_pull_off(sim, retract_speed=0.0)
 
 
+def test_predict_pull_off_catches_the_largest_pull_between_its_rows() -> None:
+    """A fast retraction (10 mm/s) from a shallow press on the default scene's pad: the largest
+    pull is the last row before the jump, a cusp the prediction's rows stepped past by 0.9 % of
+    the pull-off force (outside tester, benchmarks/outside_test_0.5.0/core_predict.py). Against
+    the same retraction done with rows 40x finer."""
+    contact = one_contact(
+        {"shape": "sphere", "radius": 5e-3},
+        glass_shear_modulus=1e6,
+        kelvin=(5e4,),
+        viscosities=(1.05e5,),
+        work=0.05,
+        numerics={"preset": "balanced", "model": "time_stepped"},
+    )
+    sim = ContactSimulator(contact)
+    depth = 41.27e-6
+    sim.step_depths(np.linspace(1e-3, 0.1, 100), np.linspace(depth / 100, depth, 100))
+    sim.step(0.11, depth=depth)
+    speed = 1e-2
+    prediction = predict_pull_off(sim, retract_speed=speed)
+    assert prediction.detached
+    rows = 40 * 400
+    t = np.linspace(0.0, 1.5 * prediction.time_to_detach, rows + 1)[1:]
+    done = sim.step_depths(sim.time + t, depth - speed * t)["force"].min()
+    assert abs(prediction.pull_off_force - done) <= 1e-3 * abs(done), (prediction.pull_off_force, done)
+
+
 def test_force_control_creeps_under_constant_load() -> None:
     sim = ContactSimulator(make_contact())
     outputs = [sim.step(i * TAU / 5, force=1e-3) for i in range(1, 40)]
