@@ -461,6 +461,14 @@ class _TimeStepped:
         # (set_state, rewind, rollback, reset, drop_memory, advance_rows) drops it or, for a
         # rollback, puts back the one from the transaction's start.
         self._force_at: tuple | None = None
+        # Rows the force search's rewinds would otherwise build again (`rewind`, `_ensure_row`,
+        # `_grow`; caches only, not state): a clone of the template a trial made from no row
+        # and the rewind dropped (with the buffers of a fresh clone), and the last growth
+        # (source row, its radius and memory, the
+        # grown row's buffers as it was built).
+        self._spare: _kernels.Row | None = None
+        self._fresh_state: np.ndarray | None = None
+        self._grown: tuple | None = None
 
     # -- the domain ---------------------------------------------------------------------
     def _build_row(
@@ -573,6 +581,20 @@ class _TimeStepped:
         at the current depth (m)."""
         row = self.row
         assert row is not None
+        grown = self._grown
+        if (
+            grown is not None
+            and grown[0] is row
+            and grown[1] == self.radius
+            and np.array_equal(grown[2], row.wl)
+            and np.array_equal(grown[3], row.wb)
+        ):
+            # The same growth from the same state again (the force search's next trial after
+            # a rewind): the row it built, back at the memory it started with.
+            target = grown[4]
+            target._state[...] = grown[5]
+            self.row = target
+            return
         length = row.length * self.numerics.growth_factor
         limit = max(1e6 * self.initial_length, 1e3)
         if length > limit:
@@ -593,6 +615,7 @@ class _TimeStepped:
         unit = np.empty_like(row.wl)
         _kernels._remap(row.wl, row.wb, float(self.radius), row.dx, row.g_c, dx, centres, memory, unit)
         self.row = self._build_row(length, memory, unit, centres, fine_profile)
+        self._grown = (row, self.radius, row.wl.copy(), row.wb.copy(), self.row, self.row._state.copy())
 
     def _unrepresentable(self, limit: float) -> str:
         """Why a contact that needs a domain longer than ``limit`` (m) cannot be stepped."""
@@ -609,8 +632,18 @@ class _TimeStepped:
             return True
         if depth < 0.0:
             return False
-        if self._template is not None:
-            self.row = self._template.with_memory(np.zeros_like(self._template.wl))
+        template = self._template
+        if template is not None:
+            spare = self._spare
+            if spare is not None and self._fresh_state is not None:
+                # The clone a force trial made and its rewind dropped, back to the buffers of
+                # a fresh clone.
+                self._spare = None
+                spare._state[...] = self._fresh_state
+                self.row = spare
+            else:
+                self.row = template.with_memory(np.zeros_like(template.wl))
+                self._fresh_state = self.row._state.copy()
             return True
         length = 1.25 * float(self.physics.profile.radius_at_height(depth))
         if not length > 0.0:
@@ -802,9 +835,21 @@ class _TimeStepped:
         search: the memory copied back in compiled code, without `set_state`'s validation
         (the arrays are the model's own copies) when the row is still the same."""
         radius, row, memory, unit, dissipated = state
-        if row is None or row is not self.row:
+        current = self.row
+        if row is None:
+            # The step started without a row: a row the trial made is this step's own; keep
+            # a clone of the template for the next trial (`_ensure_row`) instead of another.
+            template = self._template
+            if current is not None and template is not None and current._const is template._const:
+                self._spare = current
             self.set_state(state)
             return
+        if row is not current and row is not self._journal:
+            self.set_state(state)
+            return
+        # The row the step started on (the trial may have grown the domain: the transaction
+        # journalled that row, the model's own), its memory copied back.
+        self.row = row
         _kernels._restore_state(row.wl, row.wsum, row.wb, row.bsum, memory, unit)
         self.radius = radius
         self.dissipated = dissipated
