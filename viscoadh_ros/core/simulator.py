@@ -964,6 +964,63 @@ def _phase(model: Any, physics: _Physics, depth: float, r0: float, radius: float
     return _STICKING
 
 
+#: Converged force steps in a row the force search's first trial extrapolates its depth from.
+PATH_POINTS = 4
+#: Weights of the last 3 / 4 points (oldest first) that extrapolate a polynomial through them
+#: to the next point of the same spacing.
+_EQUAL_SPACING_WEIGHTS = {3: (1.0, -3.0, 3.0), 4: (-1.0, 4.0, -6.0, 4.0)}
+
+
+def _path_prediction(path: tuple, time: float, target: float, slope: float) -> float | None:
+    """The force search's first trial after converged force steps in a row: the depth where
+    the path of the last steps, extrapolated in time, meets `target` (N) at `time` (s).
+
+    `path`: (time s, depth m, force N) of the last steps, oldest first. Along a smooth
+    history the unloaded depth z = d - F / slope (`slope`: dF/dd of the last step, N/m)
+    moves smoothly (the memory creeps), and so does the depth where the commanded force is
+    met: z is extrapolated by the polynomial through the last 3 or 4 points (their spacing
+    in time, or equal spacing when it is equal to 1e-6) and the commanded force added back,
+    d = z(time) + target / slope. A wrong prediction costs trials, never the result (the
+    trial at it is checked like any other). None: fewer than 3 points, or times not
+    increasing."""
+    count = len(path)
+    if count < 3:
+        return None
+    t_last = path[-1][0]
+    step = time - t_last
+    if not step > 0.0:
+        return None
+    weights = _EQUAL_SPACING_WEIGHTS[count]
+    for index in range(count - 1):
+        spacing = path[index + 1][0] - path[index][0]
+        if abs(spacing - step) > 1e-6 * step:
+            weights = _lagrange_weights([point[0] for point in path], time)
+            if weights is None:
+                return None
+            break
+    depth = 0.0
+    force = 0.0
+    for weight, point in zip(weights, path, strict=True):
+        depth += weight * point[1]
+        force += weight * point[2]
+    return depth + (target - force) / slope
+
+
+def _lagrange_weights(times: list[float], time: float) -> tuple[float, ...] | None:
+    """Weights of the values at `times` (s, increasing) whose sum is the polynomial through
+    them at `time` (s); None when two times coincide."""
+    weights = []
+    for j, t_j in enumerate(times):
+        weight = 1.0
+        for m, t_m in enumerate(times):
+            if m != j:
+                if t_j == t_m:
+                    return None
+                weight *= (time - t_m) / (t_j - t_m)
+        weights.append(weight)
+    return tuple(weights)
+
+
 def _bracketed_root(
     residual: Any, a: float, fa: float, b: float, fb: float, tol: float
 ) -> tuple[float, float]:
@@ -1135,8 +1192,9 @@ class ContactSimulator:
         self._held_force: float | None = None
         # What the next force step predicts its root from (`_remember`): (the output it
         # belongs to, slope dF/dd N/m, drift dF/dt at a held depth N/s, the slope's change
-        # along the path N/m^2), or None.
-        self._force_memo: tuple[StepOutput, float, float, float] | None = None
+        # along the path N/m^2, the (time, depth, force) of the last PATH_POINTS converged
+        # force steps in a row, oldest first, this output's last), or None.
+        self._force_memo: tuple[StepOutput, float, float, float, tuple] | None = None
         self._model.reset()
         self._output = StepOutput(
             self._time, 0.0, 0.0, 0.0, Phase.NO_CONTACT, 0.0, 0.0, 0.0, 0.0, True, False
@@ -1507,8 +1565,10 @@ class ContactSimulator:
         memo = self._force_memo
         if memo is not None and memo[0] is self._output and was_in_contact:
             slope, drift_rate, bend = memo[1], memo[2], memo[3]
-            # F(d) ~ F(d0) + slope (d - d0), F(d0) ~ f0 + drift_rate dt.
-            first = d0 + (target - f0 - drift_rate * dt) / slope
+            first = _path_prediction(memo[4], time, target, slope)
+            if first is None:
+                # F(d) ~ F(d0) + slope (d - d0), F(d0) ~ f0 + drift_rate dt.
+                first = d0 + (target - f0 - drift_rate * dt) / slope
             root = self._predicted_root(residual, d0, first, slope, bend, stop)
             if root is not None:
                 # The model is in the state of the trial at the root: publish it as it stands.
@@ -1634,6 +1694,8 @@ class ContactSimulator:
         if previous is not None and previous[0] is not before:
             previous = None
         self._force_memo = None
+        point = (output.time, output.depth, output.force)
+        path = (point,) if previous is None else (*previous[4][1 - PATH_POINTS :], point)
         root = output.depth
         if output.unstable or output.contact_radius <= 0.0:
             return
@@ -1654,7 +1716,7 @@ class ContactSimulator:
         if previous is not None and root != d0:
             bend = (slope - previous[1]) / (root - d0)
         if math.isfinite(drift_rate) and math.isfinite(bend):
-            self._force_memo = (output, slope, drift_rate, bend)
+            self._force_memo = (output, slope, drift_rate, bend, path)
 
     def _search_dip(
         self,
