@@ -91,8 +91,6 @@ def _run(contact, commands):
     return outputs
 
 
-
-
 @pytest.mark.parametrize("name", list(_histories()))
 def test_row_reuse_gives_the_same_outputs_bit_for_bit(name, monkeypatch) -> None:
     make, commands = _histories()[name]

@@ -469,6 +469,9 @@ class _TimeStepped:
         self._spare: _kernels.Row | None = None
         self._fresh_state: np.ndarray | None = None
         self._grown: tuple | None = None
+        # The glass modulus' JKR curve (forces rising, depths) on the first domain's fine
+        # grid (`glass_contact`), built on first use.
+        self._glass_curve: tuple[np.ndarray, np.ndarray] | None = None
 
     # -- the domain ---------------------------------------------------------------------
     def _build_row(
@@ -534,6 +537,35 @@ class _TimeStepped:
         )
         self._chain_row = row
         return row
+
+    def glass_contact(self, force: float) -> tuple[float, float] | None:
+        """The instantaneous (glass) adhesive contact that carries `force` (N) on a body at
+        rest: (depth m, stiffness dF/dd N/m) on the stable branch of the JKR curve of the
+        glass modulus (MDR: F = 2 E0* (a g(a) - int_0^a g), d = g(a) - dl_c(a)), read off the
+        first domain's fine grid; None without such a domain, below the curve's force minimum
+        or beyond the domain. From rest a step responds with the glass modulus, so this is
+        close to where a force step from rest ends (a start for its search)."""
+        curve = self._glass_curve
+        if curve is None:
+            template = self._template
+            if template is None:
+                return None
+            x = self._fine_index * template.df
+            gf, gint = template.gf, template.gint
+            c = self.physics.c_crit
+            f = 2.0 * self.physics.e0 * (x * gf - gint - c * x * np.sqrt(x))
+            d = gf - c * np.sqrt(x)
+            lowest = int(np.argmin(f))
+            f, d = f[lowest:], d[lowest:]
+            rising = np.flatnonzero((np.diff(f) <= 0.0) | (np.diff(d) <= 0.0))
+            end = int(rising[0]) + 1 if rising.size else f.size
+            curve = self._glass_curve = (f[:end], d[:end])
+        f, d = curve
+        i = int(np.searchsorted(f, force))
+        if i == 0 or i >= f.size:
+            return None
+        stiffness = (f[i] - f[i - 1]) / (d[i] - d[i - 1])
+        return float(d[i - 1] + (force - f[i - 1]) / stiffness), float(stiffness)
 
     def _prepare_growth(self, row: _kernels.Row) -> None:
         """One slice of the next domain's geometry (length L x growth_factor: its fine
@@ -1565,7 +1597,7 @@ class ContactSimulator:
         memo = self._force_memo
         if memo is not None and memo[0] is self._output and was_in_contact:
             slope, drift_rate, bend = memo[1], memo[2], memo[3]
-            first = _path_prediction(memo[4], time, target, slope)
+            first = self._path_prediction(memo[4], time, target, slope)
             if first is None:
                 # F(d) ~ F(d0) + slope (d - d0), F(d0) ~ f0 + drift_rate dt.
                 first = d0 + (target - f0 - drift_rate * dt) / slope
@@ -1577,6 +1609,11 @@ class ContactSimulator:
                 return output
             trials.clear()
 
+        cold = self._from_rest(residual, d0, target, stop) if not was_in_contact else None
+        if cold is not None:
+            lo, r_lo, hi, r_hi, stop = cold
+            return self._finish_force(residual, time, target, lo, r_lo, hi, r_hi, stop, tol, last, trials)
+        trials.clear()
         r_hold = residual(d0)
         if abs(r_hold) <= tol:
             output = self._publish(time, d0, last[1], unstable=False)
@@ -1625,6 +1662,30 @@ class ContactSimulator:
         if not was_in_contact and self._attached():
             # Snapped in: the stop's floor from the contact that formed.
             stop = max(stop, self._force_stop(target, model.radius))
+        return self._finish_force(
+            residual, time, target, lo, r_lo, hi, r_hi, stop, tol, last, trials, hold_force
+        )
+
+    def _finish_force(
+        self,
+        residual,
+        time: float,
+        target: float,
+        lo: float,
+        r_lo: float,
+        hi: float,
+        r_hi: float,
+        stop: float,
+        tol: float,
+        last: list[Any],
+        trials: list[tuple[float, float, float]],
+        hold_force: float | None = None,
+    ) -> StepOutput:
+        """The bracketing search's end: the root in [lo, hi] (residuals r_lo, r_hi of
+        opposite signs, or one within `stop`) published as the step."""
+        was_in_contact = self.in_contact
+        before = self._output
+        d0, f0, dt = self._depth, before.force, time - self._time
         root, r_root = _bracketed_root(residual, lo, r_lo, hi, r_hi, stop)
         if last[0] != root:
             r_root = residual(root)
@@ -1632,14 +1693,67 @@ class ContactSimulator:
         # A residual left at the root beyond where the search stops means the force jumped
         # across the target (snap-in or a discontinuous edge): no continuous equilibrium
         # path; keep the state reached.
-        unstable = abs(r_root) > max(tol, stop, 1e-9 * abs(target)) or jumped_in
+        converged = abs(r_root) <= max(tol, stop, 1e-9 * abs(target))
+        unstable = not converged or jumped_in
         # The model is in the state of the trial at the root: publish it (no second trial).
         output = self._publish(time, root, last[1], unstable=unstable)
-        self._remember(output, before, trials, d0, f0, dt, hold_force, None)
+        # A snap-in that met the target is flagged (the force jumped) but its slope is
+        # good for the next step's prediction; its force at the held depth (out of contact)
+        # says nothing of the drift in contact: none.
+        if jumped_in:
+            hold_force, f0 = output.force, output.force
+        self._remember(output, before, trials, d0, f0, dt, hold_force, None, converged=converged)
         return output
+
+    #: Secant trials of a force step from rest (`_from_rest`) before the bracketing search.
+    REST_TRIALS = 6
+
+    def _from_rest(
+        self, residual, d0: float, target: float, stop: float
+    ) -> tuple[float, float, float, float, float] | None:
+        """A force step on a body at rest (no contact, no memory) with the held depth `d0`
+        (m) at or below the surface, on the time-stepped model: the search starts at the
+        glass modulus' JKR contact for `target` (N) (`_TimeStepped.glass_contact`: from
+        rest the body answers with its glass modulus) and takes secant steps from it,
+        instead of a trial at the held depth and doubling steps (each a snap-in from rest:
+        10 trials at a zero force). Returns (lo, r_lo, hi, r_hi, stop): a bracket of the
+        root (or one end within `stop`, the stop's floor from the contact that formed), or
+        None (the model rewound; the caller's search runs) when that contact does not exist,
+        a trial does not touch, a secant slope is not within 4x of the glass one, or
+        REST_TRIALS trials neither bracketed nor met the target."""
+        model = self._model
+        if not (d0 >= 0.0 and isinstance(model, _TimeStepped) and model.is_relaxed()):
+            return None
+        glass = model.glass_contact(target)
+        if glass is None:
+            return None
+        x, stiffness = glass
+        r = residual(x)
+        slope = stiffness
+        for _ in range(self.REST_TRIALS):
+            if not self._attached():
+                return None
+            stop = max(stop, self._force_stop(target, model.radius))
+            if abs(r) <= stop:
+                return x, r, x, r, stop
+            x_new = x - r / slope
+            if x_new == x:
+                return None
+            r_new = residual(x_new)
+            if not self._attached():
+                return None
+            if (r_new < 0.0) != (r < 0.0):
+                stop = max(stop, self._force_stop(target, model.radius))
+                return x, r, x_new, r_new, stop
+            secant = (r_new - r) / (x_new - x)
+            if not 0.25 * stiffness <= secant <= 4.0 * stiffness:
+                return None
+            x, r, slope = x_new, r_new, secant
+        return None
 
     #: Trials of the predicted secant before it gives way to the bracketing search.
     PREDICTED_TRIALS = 4
+    _path_prediction = staticmethod(_path_prediction)
 
     def _predicted_root(
         self, residual, d0: float, first: float, slope: float, bend: float, stop: float
@@ -1683,13 +1797,16 @@ class ContactSimulator:
         dt: float,
         hold_force: float | None,
         slope: float | None,
+        *,
+        converged: bool = False,
     ) -> None:
         """Keep what the next force step predicts its root from: the slope dF/dd at the root
         (from the trial nearest it, else `slope`), its change along the path since the step
         that ended in `before` (the output before this step), and the rate at which the force
         drifts at a held depth (from `hold_force`, the trial at the held depth d0, else
         extrapolated along the slope), tied to `output` (stale once the simulator's output
-        is another)."""
+        is another). An unstable output is not remembered unless `converged` (it met the
+        target)."""
         previous = self._force_memo
         if previous is not None and previous[0] is not before:
             previous = None
@@ -1697,7 +1814,7 @@ class ContactSimulator:
         point = (output.time, output.depth, output.force)
         path = (point,) if previous is None else (*previous[4][1 - PATH_POINTS :], point)
         root = output.depth
-        if output.unstable or output.contact_radius <= 0.0:
+        if (output.unstable and not converged) or output.contact_radius <= 0.0:
             return
         nearest = None
         for depth, force, radius in trials:
