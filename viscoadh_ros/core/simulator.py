@@ -1642,6 +1642,7 @@ class ContactSimulator:
         # Pulled to a zero force, an adhesive contact holds it before it lets go; a detached
         # trial (zero force too) is no root then: look for the attached one.
         adhesive = self.physics.work_of_adhesion > 0.0
+        dip_searched = False
         for _ in range(200):
             hi = lo + direction * delta
             r_hi = residual(hi)
@@ -1649,11 +1650,24 @@ class ContactSimulator:
             if r_hi * direction >= 0.0 and not (detached and r_hi == 0.0 and adhesive):
                 break
             if detached:
-                found, boundary = self._search_dip(residual, trials, target, stop)
+                found, boundary = self._search_dip(
+                    residual, trials, target, stop, golden_section=not dip_searched
+                )
                 if found is None:
                     return self._pulled_off(boundary, time, start, last)
                 lo, r_lo, hi, r_hi = found
                 break
+            if direction < 0.0 and r_hi > r_lo and not dip_searched:
+                # Pulled further, the force rose: the steps passed the force minimum above
+                # the target. Search the dip there now rather than after the steps reach
+                # the detachment (the trials there are the step's dearest: a receding edge
+                # over many cells); the same golden section, between the same neighbours of
+                # the smallest trial. None found: on to the detachment as before.
+                dip_searched = True
+                found, _ = self._search_dip(residual, trials, target, stop, detachment=False)
+                if found is not None:
+                    lo, r_lo, hi, r_hi = found
+                    break
             lo, r_lo = hi, r_hi
             delta *= 2.0
         else:
@@ -1841,6 +1855,9 @@ class ContactSimulator:
         trials: list[tuple[float, float, float]],
         target: float,
         stop: float,
+        *,
+        golden_section: bool = True,
+        detachment: bool = True,
     ) -> tuple[tuple[float, float, float, float] | None, float]:
         """A pull's bracketing steps reached a detached trial with every attached trial above
         the target: look for an attached force at or below the target between them (the
@@ -1854,12 +1871,16 @@ class ContactSimulator:
         drop within the bracket; only then is the detachment depth bisected, to 1e-13
         relative or to where the force cannot move by more than `stop` (N) across the
         interval. Both use the Lipschitz bound 2 x the glass stiffness 2 E0* a of the largest
-        contact tried (F(d) moves no faster under an instantaneous change of depth)."""
+        contact tried (F(d) moves no faster under an instantaneous change of depth).
+
+        `golden_section=False` skips the first part (a search before found no dip around
+        the same minimum), `detachment=False` the second (returns (None, nan): the steps
+        passed the minimum before they detached, see `_solve_force`)."""
         radius = max((r for _, _, r in trials), default=0.0)
         lipschitz = 4.0 * self.physics.e0 * radius
         samples = sorted(trials)
         attached = [i for i, (_, _, r) in enumerate(samples) if r > 0.0]
-        if attached:
+        if attached and golden_section:
             j = min(attached, key=lambda i: samples[i][1])
             a = samples[max(j - 1, 0)][0]
             b = samples[min(j + 1, len(samples) - 1)][0]
@@ -1899,6 +1920,8 @@ class ContactSimulator:
                     rd = value(d)
                     if rd <= 0.0:
                         return self._dip_bracket(trials, target, d, rd), math.nan
+        if not detachment:
+            return None, math.nan
         # No dip: bisect the detachment between the deepest detached trial shallower than
         # every attached one and the shallowest attached trial.
         hi = min((d for d, _, r in trials if r > 0.0), default=math.nan)
