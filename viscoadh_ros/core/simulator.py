@@ -996,6 +996,10 @@ def _phase(model: Any, physics: _Physics, depth: float, r0: float, radius: float
     return _STICKING
 
 
+#: The force search's predicted secant gives way to the bracketing search where the slope
+#: dF/dd is below this fraction of the glass stiffness 2 E0* a (near the fold of F(d); away
+#: from it a step's slope is 0.46 to 1 times the glass stiffness on the bench's history).
+FOLD_SLOPE = 0.3
 #: Converged force steps in a row the force search's first trial extrapolates its depth from.
 PATH_POINTS = 4
 #: Weights of the last 3 / 4 points (oldest first) that extrapolate a polynomial through them
@@ -1595,13 +1599,14 @@ class ContactSimulator:
             return result[1] - target
 
         memo = self._force_memo
-        if memo is not None and memo[0] is self._output and was_in_contact:
+        glass = 2.0 * self.physics.e0 * before.contact_radius
+        if memo is not None and memo[0] is self._output and was_in_contact and memo[1] >= FOLD_SLOPE * glass:
             slope, drift_rate, bend = memo[1], memo[2], memo[3]
             first = self._path_prediction(memo[4], time, target, slope)
             if first is None:
                 # F(d) ~ F(d0) + slope (d - d0), F(d0) ~ f0 + drift_rate dt.
                 first = d0 + (target - f0 - drift_rate * dt) / slope
-            root = self._predicted_root(residual, d0, first, slope, bend, stop)
+            root = self._predicted_root(residual, d0, first, slope, bend, stop, glass)
             if root is not None:
                 # The model is in the state of the trial at the root: publish it as it stands.
                 output = self._publish(time, root, last[1], unstable=False)
@@ -1770,15 +1775,17 @@ class ContactSimulator:
     _path_prediction = staticmethod(_path_prediction)
 
     def _predicted_root(
-        self, residual, d0: float, first: float, slope: float, bend: float, stop: float
+        self, residual, d0: float, first: float, slope: float, bend: float, stop: float, glass: float
     ) -> float | None:
         """Secant steps from the predicted depth `first` (m), the first with the last step's
         slope `slope` (N/m) carried from the held depth `d0` to `first` by its change along
         the path `bend` (N/m^2). Returns the depth of the trial within `stop` (N) of the
         target (the model left in its state), or None when a trial detaches, a secant slope
         is not within a factor 4 of `slope` (the force-depth curve bends: a fold or a jump is
-        near, which the bracketing search handles) or PREDICTED_TRIALS trials did not
-        converge."""
+        near, which the bracketing search handles), a secant step is longer than a step on
+        FOLD_SLOPE times the glass stiffness `glass` (N/m) (a flat F(d) near the fold: such
+        steps ran to the detachment, the step's dearest trials) or PREDICTED_TRIALS trials
+        did not converge."""
         x = first
         r = residual(x)
         if not self._attached():
@@ -1790,7 +1797,7 @@ class ContactSimulator:
             if abs(r) <= stop:
                 return x
             x_new = x - r / tangent
-            if x_new == x:
+            if x_new == x or abs(x_new - x) * FOLD_SLOPE * glass > abs(r):
                 return None
             r_new = residual(x_new)
             if not self._attached():
