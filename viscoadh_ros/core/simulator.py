@@ -1770,8 +1770,11 @@ class ContactSimulator:
             x, r, slope = x_new, r_new, secant
         return None
 
-    #: Trials of the predicted secant before it gives way to the bracketing search.
+    #: Trials of the predicted secant before it gives way to the bracketing search, and up
+    #: to how many it goes on while each trial cuts the residual 100-fold (converging: a
+    #: jump of the commanded force, a zero force whose stop is 1e-12 of the adhesive force).
     PREDICTED_TRIALS = 4
+    PREDICTED_TRIALS_CONVERGING = 7
     _path_prediction = staticmethod(_path_prediction)
 
     def _predicted_root(
@@ -1785,7 +1788,8 @@ class ContactSimulator:
         near, which the bracketing search handles), a secant step is longer than a step on
         FOLD_SLOPE times the glass stiffness `glass` (N/m) (a flat F(d) near the fold: such
         steps ran to the detachment, the step's dearest trials) or PREDICTED_TRIALS trials
-        did not converge."""
+        (up to PREDICTED_TRIALS_CONVERGING while each cuts the residual 100-fold) did not
+        converge."""
         x = first
         r = residual(x)
         if not self._attached():
@@ -1793,9 +1797,12 @@ class ContactSimulator:
         tangent = slope + bend * (first - d0)
         if not 0.5 * slope < tangent < 2.0 * slope:
             tangent = slope
-        for _ in range(self.PREDICTED_TRIALS - 1):
+        shrunk = False
+        for trial in range(2, self.PREDICTED_TRIALS_CONVERGING + 1):
             if abs(r) <= stop:
                 return x
+            if trial > self.PREDICTED_TRIALS and not shrunk:
+                return None
             x_new = x - r / tangent
             if x_new == x or abs(x_new - x) * FOLD_SLOPE * glass > abs(r):
                 return None
@@ -1805,6 +1812,7 @@ class ContactSimulator:
             secant = (r_new - r) / (x_new - x)
             if not 0.25 * slope <= secant <= 4.0 * slope:
                 return None
+            shrunk = abs(r_new) <= 0.01 * abs(r)
             x, r, tangent = x_new, r_new, secant
         return x if abs(r) <= stop else None
 
