@@ -6,7 +6,9 @@ from rest). A trial that grew the domain left the grown row; the rewind cloned t
 from the step's start state and the next trial grew it again. Now the rewind keeps the clone
 as a spare (`_TimeStepped._spare`, reset to a fresh clone's buffers), points the model back at
 its own journalled row, and the same growth from the same state reuses the row it built
-(`_TimeStepped._grown`). The 0.4.0 code of those three methods is kept below as the reference;
+(`_TimeStepped._grown`). The search's start state holds no copy of the memory either
+(`trial_start`): a rewind takes it from the transaction's journal. The 0.4.0 code of those
+methods is kept below as the reference (and `get_state` for `trial_start`);
 every output of every force history must be the same, bit for bit, and each reuse must have
 happened.
 """
@@ -99,6 +101,7 @@ def test_row_reuse_gives_the_same_outputs_bit_for_bit(name, monkeypatch) -> None
         patch.setattr(_TimeStepped, "rewind", _old_rewind)
         patch.setattr(_TimeStepped, "_ensure_row", _old_ensure_row)
         patch.setattr(_TimeStepped, "_grow", _old_grow)
+        patch.setattr(_TimeStepped, "trial_start", _TimeStepped.get_state)
         old = _run(make(), commands)
     differs = [i for i, (a, b) in enumerate(zip(new, old, strict=True)) if a != b]
     assert not differs, f"{name}: rows {differs[:5]} differ: {new[differs[0]]} vs {old[differs[0]]}"
@@ -137,3 +140,18 @@ def test_each_reuse_happens() -> None:
     finally:
         patch.undo()
     assert counts["spare"] >= 1 and counts["journal"] >= 1 and counts["grown"] >= 1, counts
+
+
+def test_undo_after_force_steps_brings_back_the_state_bit_for_bit() -> None:
+    """`core.hand` undoes a step that succeeded from its token: the memory comes back from
+    the journal, which the force search's rewinds rewrite (`trial_start`). After undoing
+    each force step of the bench history's first 400 rows (snap-in from rest, growths, the
+    predicted secant, bracketing) the step taken again gives the same output."""
+    contact, commands = _histories()["default_bench_sine"]
+    sim = ContactSimulator(contact())
+    for kind, t, value in commands[:400]:
+        assert kind == "force"
+        token = sim._undo_token()
+        first = sim.step(t, force=value)
+        sim._undo(token)
+        assert sim.step(t, force=value) == first, t

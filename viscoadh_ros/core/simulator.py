@@ -862,12 +862,35 @@ class _TimeStepped:
             return float(self.physics.profile.g(radius))
         return float(_kernels._g_at(radius, self.row.gf, self.row.df))
 
+    def trial_start(self) -> tuple:
+        """`get_state` without the copies of the memory, for `rewind` inside the step that
+        took it (the force search): the memory comes back from the transaction's journal,
+        which the step's first kernel call on the row writes."""
+        return (self.radius, self.row, None, None, self.dissipated)
+
     def rewind(self, state: tuple) -> None:
-        """Back to `state` (from `get_state` of this model) for the next trial of the force
-        search: the memory copied back in compiled code, without `set_state`'s validation
-        (the arrays are the model's own copies) when the row is still the same."""
+        """Back to `state` (from `get_state` of this model, or `trial_start` in this step)
+        for the next trial of the force search: the memory copied back in compiled code,
+        without `set_state`'s validation (the arrays are the model's own copies) when the row
+        is still the same."""
         radius, row, memory, unit, dissipated = state
         current = self.row
+        if row is not None and memory is None:
+            # `trial_start`: the row the step started on, the model's own.
+            if self._journal is row:
+                # The kernel wrote it since: its memory back from the journal, which the
+                # next kernel call writes again (the same values) instead of `advance`
+                # copying the state for a growth.
+                _kernels._restore_state(row.wl, row.wsum, row.wb, row.bsum, row.txn, row.txn_b)
+                self._journal = None
+            # else no kernel call wrote it in this step (a trial dropped it as idle).
+            self.row = row
+            self.radius = radius
+            self.dissipated = dissipated
+            self._memory_peak = None
+            self._edge_depth = math.nan
+            self._force_at = None
+            return
         if row is None:
             # The step started without a row: a row the trial made is this step's own; keep
             # a clone of the template for the next trial (`_ensure_row`) instead of another.
@@ -1578,7 +1601,7 @@ class ContactSimulator:
         # The model's state before the step (the simulator's own fields change only when the
         # result is published): every trial but the first rewinds the model to it.
         model = self._model
-        start = model.get_state()
+        start = model.trial_start() if isinstance(model, _TimeStepped) else model.get_state()
         d0 = self._depth
         before = self._output
         f0 = before.force
