@@ -469,9 +469,9 @@ class _TimeStepped:
         self._spare: _kernels.Row | None = None
         self._fresh_state: np.ndarray | None = None
         self._grown: tuple | None = None
-        # The glass modulus' JKR curve (forces rising, depths) on the first domain's fine
-        # grid (`glass_contact`), built on first use.
-        self._glass_curve: tuple[np.ndarray, np.ndarray] | None = None
+        # The fine point where the glass modulus' JKR curve on the first domain has its
+        # force minimum (`glass_contact`), found on first use.
+        self._glass_lowest: int | None = None
 
     # -- the domain ---------------------------------------------------------------------
     def _build_row(
@@ -541,31 +541,53 @@ class _TimeStepped:
     def glass_contact(self, force: float) -> tuple[float, float] | None:
         """The instantaneous (glass) adhesive contact that carries `force` (N) on a body at
         rest: (depth m, stiffness dF/dd N/m) on the stable branch of the JKR curve of the
-        glass modulus (MDR: F = 2 E0* (a g(a) - int_0^a g), d = g(a) - dl_c(a)), read off the
-        first domain's fine grid; None without such a domain, below the curve's force minimum
-        or beyond the domain. From rest a step responds with the glass modulus, so this is
-        close to where a force step from rest ends (a start for its search)."""
-        curve = self._glass_curve
-        if curve is None:
-            template = self._template
-            if template is None:
-                return None
-            x = self._fine_index * template.df
-            gf, gint = template.gf, template.gint
-            c = self.physics.c_crit
-            f = 2.0 * self.physics.e0 * (x * gf - gint - c * x * np.sqrt(x))
-            d = gf - c * np.sqrt(x)
-            lowest = int(np.argmin(f))
-            f, d = f[lowest:], d[lowest:]
-            rising = np.flatnonzero((np.diff(f) <= 0.0) | (np.diff(d) <= 0.0))
-            end = int(rising[0]) + 1 if rising.size else f.size
-            curve = self._glass_curve = (f[:end], d[:end])
-        f, d = curve
-        i = int(np.searchsorted(f, force))
-        if i == 0 or i >= f.size:
+        glass modulus (MDR: F = 2 E0* (a g(a) - int_0^a g) - 2 E0* dl_c(a) a, d = g(a) -
+        dl_c(a)), between the first domain's fine points (bisection over them: the curve
+        falls to its minimum, then rises); None without such a domain, below the curve's
+        force minimum or beyond the domain. From rest a step responds with the glass
+        modulus, so this is close to where a force step from rest ends (a start for its
+        search, checked by its trials)."""
+        template = self._template
+        if template is None:
             return None
-        stiffness = (f[i] - f[i - 1]) / (d[i] - d[i - 1])
-        return float(d[i - 1] + (force - f[i - 1]) / stiffness), float(stiffness)
+        gf, gint, df = template.gf, template.gint, template.df
+        last = gf.shape[0] - 1
+        c = self.physics.c_crit
+        scale = 2.0 * self.physics.e0
+
+        def point(i: int) -> tuple[float, float]:
+            x = i * df
+            root = math.sqrt(x)
+            g = gf.item(i)
+            return scale * (x * g - gint.item(i) - c * x * root), g - c * root
+
+        lowest = self._glass_lowest
+        if lowest is None:
+            # The first fine point where the curve stops falling.
+            lo, hi = 0, last
+            while hi - lo > 1:
+                mid = (lo + hi) // 2
+                if point(mid + 1)[0] > point(mid)[0]:
+                    hi = mid
+                else:
+                    lo = mid
+            lowest = self._glass_lowest = hi
+        f_lo, d_lo = point(lowest)
+        f_hi, d_hi = point(last)
+        if not f_lo < force < f_hi:
+            return None
+        lo, hi = lowest, last
+        while hi - lo > 1:
+            mid = (lo + hi) // 2
+            f_mid, d_mid = point(mid)
+            if f_mid < force:
+                lo, f_lo, d_lo = mid, f_mid, d_mid
+            else:
+                hi, f_hi, d_hi = mid, f_mid, d_mid
+        if not (f_hi > f_lo and d_hi > d_lo):
+            return None
+        stiffness = (f_hi - f_lo) / (d_hi - d_lo)
+        return d_lo + (force - f_lo) / stiffness, stiffness
 
     def _prepare_growth(self, row: _kernels.Row) -> None:
         """One slice of the next domain's geometry (length L x growth_factor: its fine
