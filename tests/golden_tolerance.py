@@ -26,7 +26,14 @@ Force control (`FORCED_RELATIVE` = 1e-7): a force step stops anywhere inside its
 (half the force tolerance, >= 1e-5 of the commanded force in every preset), so trials whose
 forces moved at the 1e-15 level may stop at another point of that band (two rows of one
 golden scene did: depth, force and radius moved by ~1e-8 of their largest values). 1e-7 is
-still two orders below the band.
+still two orders below the band. That pins the search's own trials too: in 0.5.0 the force
+search starts elsewhere (from rest at the glass JKR contact, after converged steps on the
+path extrapolated in time, `force0`), so its steps end at other points of the band; the
+`forced` arrays were written again from it (the rest of the file unchanged). Against the
+0.4.0 arrays, every row's force is within the force tolerance of its target in both (the same
+5 rows of `default_sine` beyond it in both: flagged pull-off rows), the contact is the same on
+every row, and the depth moved by up to 1.8e-3 of its largest value (`k1_regrowth` on `fast`,
+where F(d) is flat while the edge crosses a cell; 2e-5 or less on the other scenes).
 """
 
 from __future__ import annotations

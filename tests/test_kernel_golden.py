@@ -13,7 +13,9 @@ still crossed in one substep of at most JUMP_RESOLUTION dt, tests/test_touch_tim
 benchmarks/rounds/0.4.0-snap.md states how far its outputs are from the 0.2.0 file's. The
 0.4.0 kernel's K = 1 losses summed in four lanes (`elem`) moved the energy dissipated by
 rounding (<= 1.2e-15 of its largest value), within the same tolerance; `golden_tolerance`
-says why.
+says why. In 0.5.0 the `<scene>/forced` arrays alone were written again (the force search's
+new starts stop at other points of the force tolerance's band; `golden_tolerance` says how
+far), by `benchmarks/rounds/0.5.0-force0.md`'s procedure; every other array is the 0.4.0 file's.
 """
 
 from __future__ import annotations

@@ -461,6 +461,17 @@ class _TimeStepped:
         # (set_state, rewind, rollback, reset, drop_memory, advance_rows) drops it or, for a
         # rollback, puts back the one from the transaction's start.
         self._force_at: tuple | None = None
+        # Rows the force search's rewinds would otherwise build again (`rewind`, `_ensure_row`,
+        # `_grow`; caches only, not state): a clone of the template a trial made from no row
+        # and the rewind dropped (with the buffers of a fresh clone), and the last growth
+        # (source row, its radius and memory, the
+        # grown row's buffers as it was built).
+        self._spare: _kernels.Row | None = None
+        self._fresh_state: np.ndarray | None = None
+        self._grown: tuple | None = None
+        # The fine point where the glass modulus' JKR curve on the first domain has its
+        # force minimum (`glass_contact`), found on first use.
+        self._glass_lowest: int | None = None
 
     # -- the domain ---------------------------------------------------------------------
     def _build_row(
@@ -527,6 +538,57 @@ class _TimeStepped:
         self._chain_row = row
         return row
 
+    def glass_contact(self, force: float) -> tuple[float, float] | None:
+        """The instantaneous (glass) adhesive contact that carries `force` (N) on a body at
+        rest: (depth m, stiffness dF/dd N/m) on the stable branch of the JKR curve of the
+        glass modulus (MDR: F = 2 E0* (a g(a) - int_0^a g) - 2 E0* dl_c(a) a, d = g(a) -
+        dl_c(a)), between the first domain's fine points (bisection over them: the curve
+        falls to its minimum, then rises); None without such a domain, below the curve's
+        force minimum or beyond the domain. From rest a step responds with the glass
+        modulus, so this is close to where a force step from rest ends (a start for its
+        search, checked by its trials)."""
+        template = self._template
+        if template is None:
+            return None
+        gf, gint, df = template.gf, template.gint, template.df
+        last = gf.shape[0] - 1
+        c = self.physics.c_crit
+        scale = 2.0 * self.physics.e0
+
+        def point(i: int) -> tuple[float, float]:
+            x = i * df
+            root = math.sqrt(x)
+            g = gf.item(i)
+            return scale * (x * g - gint.item(i) - c * x * root), g - c * root
+
+        lowest = self._glass_lowest
+        if lowest is None:
+            # The first fine point where the curve stops falling.
+            lo, hi = 0, last
+            while hi - lo > 1:
+                mid = (lo + hi) // 2
+                if point(mid + 1)[0] > point(mid)[0]:
+                    hi = mid
+                else:
+                    lo = mid
+            lowest = self._glass_lowest = hi
+        f_lo, d_lo = point(lowest)
+        f_hi, d_hi = point(last)
+        if not f_lo < force < f_hi:
+            return None
+        lo, hi = lowest, last
+        while hi - lo > 1:
+            mid = (lo + hi) // 2
+            f_mid, d_mid = point(mid)
+            if f_mid < force:
+                lo, f_lo, d_lo = mid, f_mid, d_mid
+            else:
+                hi, f_hi, d_hi = mid, f_mid, d_mid
+        if not (f_hi > f_lo and d_hi > d_lo):
+            return None
+        stiffness = (f_hi - f_lo) / (d_hi - d_lo)
+        return d_lo + (force - f_lo) / stiffness, stiffness
+
     def _prepare_growth(self, row: _kernels.Row) -> None:
         """One slice of the next domain's geometry (length L x growth_factor: its fine
         profile and integral, then its centre profile), so that a growth, when it comes,
@@ -573,6 +635,20 @@ class _TimeStepped:
         at the current depth (m)."""
         row = self.row
         assert row is not None
+        grown = self._grown
+        if (
+            grown is not None
+            and grown[0] is row
+            and grown[1] == self.radius
+            and np.array_equal(grown[2], row.wl)
+            and np.array_equal(grown[3], row.wb)
+        ):
+            # The same growth from the same state again (the force search's next trial after
+            # a rewind): the row it built, back at the memory it started with.
+            target = grown[4]
+            target._state[...] = grown[5]
+            self.row = target
+            return
         length = row.length * self.numerics.growth_factor
         limit = max(1e6 * self.initial_length, 1e3)
         if length > limit:
@@ -593,6 +669,7 @@ class _TimeStepped:
         unit = np.empty_like(row.wl)
         _kernels._remap(row.wl, row.wb, float(self.radius), row.dx, row.g_c, dx, centres, memory, unit)
         self.row = self._build_row(length, memory, unit, centres, fine_profile)
+        self._grown = (row, self.radius, row.wl.copy(), row.wb.copy(), self.row, self.row._state.copy())
 
     def _unrepresentable(self, limit: float) -> str:
         """Why a contact that needs a domain longer than ``limit`` (m) cannot be stepped."""
@@ -609,8 +686,18 @@ class _TimeStepped:
             return True
         if depth < 0.0:
             return False
-        if self._template is not None:
-            self.row = self._template.with_memory(np.zeros_like(self._template.wl))
+        template = self._template
+        if template is not None:
+            spare = self._spare
+            if spare is not None and self._fresh_state is not None:
+                # The clone a force trial made and its rewind dropped, back to the buffers of
+                # a fresh clone.
+                self._spare = None
+                spare._state[...] = self._fresh_state
+                self.row = spare
+            else:
+                self.row = template.with_memory(np.zeros_like(template.wl))
+                self._fresh_state = self.row._state.copy()
             return True
         length = 1.25 * float(self.physics.profile.radius_at_height(depth))
         if not length > 0.0:
@@ -797,14 +884,49 @@ class _TimeStepped:
             return float(self.physics.profile.g(radius))
         return float(_kernels._g_at(radius, self.row.gf, self.row.df))
 
+    def trial_start(self) -> tuple:
+        """`get_state` without the copies of the memory, for `rewind` inside the step that
+        took it (the force search): the memory comes back from the transaction's journal,
+        which the step's first kernel call on the row writes."""
+        return (self.radius, self.row, None, None, self.dissipated)
+
     def rewind(self, state: tuple) -> None:
-        """Back to `state` (from `get_state` of this model) for the next trial of the force
-        search: the memory copied back in compiled code, without `set_state`'s validation
-        (the arrays are the model's own copies) when the row is still the same."""
+        """Back to `state` (from `get_state` of this model, or `trial_start` in this step)
+        for the next trial of the force search: the memory copied back in compiled code,
+        without `set_state`'s validation (the arrays are the model's own copies) when the row
+        is still the same."""
         radius, row, memory, unit, dissipated = state
-        if row is None or row is not self.row:
+        current = self.row
+        if row is not None and memory is None:
+            # `trial_start`: the row the step started on, the model's own.
+            if self._journal is row:
+                # The kernel wrote it since: its memory back from the journal, which the
+                # next kernel call writes again (the same values) instead of `advance`
+                # copying the state for a growth.
+                _kernels._restore_state(row.wl, row.wsum, row.wb, row.bsum, row.txn, row.txn_b)
+                self._journal = None
+            # else no kernel call wrote it in this step (a trial dropped it as idle).
+            self.row = row
+            self.radius = radius
+            self.dissipated = dissipated
+            self._memory_peak = None
+            self._edge_depth = math.nan
+            self._force_at = None
+            return
+        if row is None:
+            # The step started without a row: a row the trial made is this step's own; keep
+            # a clone of the template for the next trial (`_ensure_row`) instead of another.
+            template = self._template
+            if current is not None and template is not None and current._const is template._const:
+                self._spare = current
             self.set_state(state)
             return
+        if row is not current and row is not self._journal:
+            self.set_state(state)
+            return
+        # The row the step started on (the trial may have grown the domain: the transaction
+        # journalled that row, the model's own), its memory copied back.
+        self.row = row
         _kernels._restore_state(row.wl, row.wsum, row.wb, row.bsum, memory, unit)
         self.radius = radius
         self.dissipated = dissipated
@@ -917,6 +1039,67 @@ def _phase(model: Any, physics: _Physics, depth: float, r0: float, radius: float
     if inside <= tol:
         return _DETACHING
     return _STICKING
+
+
+#: The force search's predicted secant gives way to the bracketing search where the slope
+#: dF/dd is below this fraction of the glass stiffness 2 E0* a (near the fold of F(d); away
+#: from it a step's slope is 0.46 to 1 times the glass stiffness on the bench's history).
+FOLD_SLOPE = 0.3
+#: Converged force steps in a row the force search's first trial extrapolates its depth from.
+PATH_POINTS = 4
+#: Weights of the last 3 / 4 points (oldest first) that extrapolate a polynomial through them
+#: to the next point of the same spacing.
+_EQUAL_SPACING_WEIGHTS = {3: (1.0, -3.0, 3.0), 4: (-1.0, 4.0, -6.0, 4.0)}
+
+
+def _path_prediction(path: tuple, time: float, target: float, slope: float) -> float | None:
+    """The force search's first trial after converged force steps in a row: the depth where
+    the path of the last steps, extrapolated in time, meets `target` (N) at `time` (s).
+
+    `path`: (time s, depth m, force N) of the last steps, oldest first. Along a smooth
+    history the unloaded depth z = d - F / slope (`slope`: dF/dd of the last step, N/m)
+    moves smoothly (the memory creeps), and so does the depth where the commanded force is
+    met: z is extrapolated by the polynomial through the last 3 or 4 points (their spacing
+    in time, or equal spacing when it is equal to 1e-6) and the commanded force added back,
+    d = z(time) + target / slope. A wrong prediction costs trials, never the result (the
+    trial at it is checked like any other). None: fewer than 3 points, or times not
+    increasing."""
+    count = len(path)
+    if count < 3:
+        return None
+    t_last = path[-1][0]
+    step = time - t_last
+    if not step > 0.0:
+        return None
+    weights = _EQUAL_SPACING_WEIGHTS[count]
+    for index in range(count - 1):
+        spacing = path[index + 1][0] - path[index][0]
+        if abs(spacing - step) > 1e-6 * step:
+            weights = _lagrange_weights([point[0] for point in path], time)
+            if weights is None:
+                return None
+            break
+    depth = 0.0
+    force = 0.0
+    for weight, point in zip(weights, path, strict=True):
+        depth += weight * point[1]
+        force += weight * point[2]
+    return depth + (target - force) / slope
+
+
+def _lagrange_weights(times: list[float], time: float) -> tuple[float, ...] | None:
+    """Weights of the values at `times` (s, increasing) whose sum is the polynomial through
+    them at `time` (s); None when two times coincide."""
+    weights = []
+    for j, t_j in enumerate(times):
+        weight = 1.0
+        for m, t_m in enumerate(times):
+            if m != j:
+                if t_j == t_m:
+                    return None
+                weight *= (time - t_m) / (t_j - t_m)
+        weights.append(weight)
+    return tuple(weights)
 
 
 def _bracketed_root(
@@ -1092,8 +1275,9 @@ class ContactSimulator:
         self._held_force: float | None = None
         # What the next force step predicts its root from (`_remember`): (the output it
         # belongs to, slope dF/dd N/m, drift dF/dt at a held depth N/s, the slope's change
-        # along the path N/m^2), or None.
-        self._force_memo: tuple[StepOutput, float, float, float] | None = None
+        # along the path N/m^2, the (time, depth, force) of the last PATH_POINTS converged
+        # force steps in a row, oldest first, this output's last), or None.
+        self._force_memo: tuple[StepOutput, float, float, float, tuple] | None = None
         self._model.reset()
         self._output = StepOutput(
             self._time, 0.0, 0.0, 0.0, Phase.NO_CONTACT, 0.0, 0.0, 0.0, 0.0, True, False
@@ -1453,7 +1637,7 @@ class ContactSimulator:
         # The model's state before the step (the simulator's own fields change only when the
         # result is published): every trial but the first rewinds the model to it.
         model = self._model
-        start = model.get_state()
+        start = model.trial_start() if isinstance(model, _TimeStepped) else model.get_state()
         d0 = self._depth
         before = self._output
         f0 = before.force
@@ -1474,11 +1658,14 @@ class ContactSimulator:
             return result[1] - target
 
         memo = self._force_memo
-        if memo is not None and memo[0] is self._output and was_in_contact:
+        glass = 2.0 * self.physics.e0 * before.contact_radius
+        if memo is not None and memo[0] is self._output and was_in_contact and memo[1] >= FOLD_SLOPE * glass:
             slope, drift_rate, bend = memo[1], memo[2], memo[3]
-            # F(d) ~ F(d0) + slope (d - d0), F(d0) ~ f0 + drift_rate dt.
-            first = d0 + (target - f0 - drift_rate * dt) / slope
-            root = self._predicted_root(residual, d0, first, slope, bend, stop)
+            first = self._path_prediction(memo[4], time, target, slope)
+            if first is None:
+                # F(d) ~ F(d0) + slope (d - d0), F(d0) ~ f0 + drift_rate dt.
+                first = d0 + (target - f0 - drift_rate * dt) / slope
+            root = self._predicted_root(residual, d0, first, slope, bend, stop, glass)
             if root is not None:
                 # The model is in the state of the trial at the root: publish it as it stands.
                 output = self._publish(time, root, last[1], unstable=False)
@@ -1486,6 +1673,11 @@ class ContactSimulator:
                 return output
             trials.clear()
 
+        cold = self._from_rest(residual, d0, target, stop) if not was_in_contact else None
+        if cold is not None:
+            lo, r_lo, hi, r_hi, stop = cold
+            return self._finish_force(residual, time, target, lo, r_lo, hi, r_hi, stop, tol, last, trials)
+        trials.clear()
         r_hold = residual(d0)
         if abs(r_hold) <= tol:
             output = self._publish(time, d0, last[1], unstable=False)
@@ -1514,6 +1706,7 @@ class ContactSimulator:
         # Pulled to a zero force, an adhesive contact holds it before it lets go; a detached
         # trial (zero force too) is no root then: look for the attached one.
         adhesive = self.physics.work_of_adhesion > 0.0
+        dip_searched = False
         for _ in range(200):
             hi = lo + direction * delta
             r_hi = residual(hi)
@@ -1521,11 +1714,24 @@ class ContactSimulator:
             if r_hi * direction >= 0.0 and not (detached and r_hi == 0.0 and adhesive):
                 break
             if detached:
-                found, boundary = self._search_dip(residual, trials, target, stop)
+                found, boundary = self._search_dip(
+                    residual, trials, target, stop, golden_section=not dip_searched
+                )
                 if found is None:
                     return self._pulled_off(boundary, time, start, last)
                 lo, r_lo, hi, r_hi = found
                 break
+            if direction < 0.0 and r_hi > r_lo and not dip_searched:
+                # Pulled further, the force rose: the steps passed the force minimum above
+                # the target. Search the dip there now rather than after the steps reach
+                # the detachment (the trials there are the step's dearest: a receding edge
+                # over many cells); the same golden section, between the same neighbours of
+                # the smallest trial. None found: on to the detachment as before.
+                dip_searched = True
+                found, _ = self._search_dip(residual, trials, target, stop, detachment=False)
+                if found is not None:
+                    lo, r_lo, hi, r_hi = found
+                    break
             lo, r_lo = hi, r_hi
             delta *= 2.0
         else:
@@ -1534,6 +1740,30 @@ class ContactSimulator:
         if not was_in_contact and self._attached():
             # Snapped in: the stop's floor from the contact that formed.
             stop = max(stop, self._force_stop(target, model.radius))
+        return self._finish_force(
+            residual, time, target, lo, r_lo, hi, r_hi, stop, tol, last, trials, hold_force
+        )
+
+    def _finish_force(
+        self,
+        residual,
+        time: float,
+        target: float,
+        lo: float,
+        r_lo: float,
+        hi: float,
+        r_hi: float,
+        stop: float,
+        tol: float,
+        last: list[Any],
+        trials: list[tuple[float, float, float]],
+        hold_force: float | None = None,
+    ) -> StepOutput:
+        """The bracketing search's end: the root in [lo, hi] (residuals r_lo, r_hi of
+        opposite signs, or one within `stop`) published as the step."""
+        was_in_contact = self.in_contact
+        before = self._output
+        d0, f0, dt = self._depth, before.force, time - self._time
         root, r_root = _bracketed_root(residual, lo, r_lo, hi, r_hi, stop)
         if last[0] != root:
             r_root = residual(root)
@@ -1541,24 +1771,83 @@ class ContactSimulator:
         # A residual left at the root beyond where the search stops means the force jumped
         # across the target (snap-in or a discontinuous edge): no continuous equilibrium
         # path; keep the state reached.
-        unstable = abs(r_root) > max(tol, stop, 1e-9 * abs(target)) or jumped_in
+        converged = abs(r_root) <= max(tol, stop, 1e-9 * abs(target))
+        unstable = not converged or jumped_in
         # The model is in the state of the trial at the root: publish it (no second trial).
         output = self._publish(time, root, last[1], unstable=unstable)
-        self._remember(output, before, trials, d0, f0, dt, hold_force, None)
+        # A snap-in that met the target is flagged (the force jumped) but its slope is
+        # good for the next step's prediction; its force at the held depth (out of contact)
+        # says nothing of the drift in contact: none.
+        if jumped_in:
+            hold_force, f0 = output.force, output.force
+        self._remember(output, before, trials, d0, f0, dt, hold_force, None, converged=converged)
         return output
 
-    #: Trials of the predicted secant before it gives way to the bracketing search.
+    #: Secant trials of a force step from rest (`_from_rest`) before the bracketing search.
+    REST_TRIALS = 6
+
+    def _from_rest(
+        self, residual, d0: float, target: float, stop: float
+    ) -> tuple[float, float, float, float, float] | None:
+        """A force step on a body at rest (no contact, no memory) with the held depth `d0`
+        (m) at or below the surface, on the time-stepped model: the search starts at the
+        glass modulus' JKR contact for `target` (N) (`_TimeStepped.glass_contact`: from
+        rest the body answers with its glass modulus) and takes secant steps from it,
+        instead of a trial at the held depth and doubling steps (each a snap-in from rest:
+        10 trials at a zero force). Returns (lo, r_lo, hi, r_hi, stop): a bracket of the
+        root (or one end within `stop`, the stop's floor from the contact that formed), or
+        None (the model rewound; the caller's search runs) when that contact does not exist,
+        a trial does not touch, a secant slope is not within 4x of the glass one, or
+        REST_TRIALS trials neither bracketed nor met the target."""
+        model = self._model
+        if not (d0 >= 0.0 and isinstance(model, _TimeStepped) and model.is_relaxed()):
+            return None
+        glass = model.glass_contact(target)
+        if glass is None:
+            return None
+        x, stiffness = glass
+        r = residual(x)
+        slope = stiffness
+        for _ in range(self.REST_TRIALS):
+            if not self._attached():
+                return None
+            stop = max(stop, self._force_stop(target, model.radius))
+            if abs(r) <= stop:
+                return x, r, x, r, stop
+            x_new = x - r / slope
+            if x_new == x:
+                return None
+            r_new = residual(x_new)
+            if not self._attached():
+                return None
+            if (r_new < 0.0) != (r < 0.0):
+                stop = max(stop, self._force_stop(target, model.radius))
+                return x, r, x_new, r_new, stop
+            secant = (r_new - r) / (x_new - x)
+            if not 0.25 * stiffness <= secant <= 4.0 * stiffness:
+                return None
+            x, r, slope = x_new, r_new, secant
+        return None
+
+    #: Trials of the predicted secant before it gives way to the bracketing search, and up
+    #: to how many it goes on while each trial cuts the residual 100-fold (converging: a
+    #: jump of the commanded force, a zero force whose stop is 1e-12 of the adhesive force).
     PREDICTED_TRIALS = 4
+    PREDICTED_TRIALS_CONVERGING = 7
+    _path_prediction = staticmethod(_path_prediction)
 
     def _predicted_root(
-        self, residual, d0: float, first: float, slope: float, bend: float, stop: float
+        self, residual, d0: float, first: float, slope: float, bend: float, stop: float, glass: float
     ) -> float | None:
         """Secant steps from the predicted depth `first` (m), the first with the last step's
         slope `slope` (N/m) carried from the held depth `d0` to `first` by its change along
         the path `bend` (N/m^2). Returns the depth of the trial within `stop` (N) of the
         target (the model left in its state), or None when a trial detaches, a secant slope
         is not within a factor 4 of `slope` (the force-depth curve bends: a fold or a jump is
-        near, which the bracketing search handles) or PREDICTED_TRIALS trials did not
+        near, which the bracketing search handles), a secant step is longer than a step on
+        FOLD_SLOPE times the glass stiffness `glass` (N/m) (a flat F(d) near the fold: such
+        steps ran to the detachment, the step's dearest trials) or PREDICTED_TRIALS trials
+        (up to PREDICTED_TRIALS_CONVERGING while each cuts the residual 100-fold) did not
         converge."""
         x = first
         r = residual(x)
@@ -1567,11 +1856,14 @@ class ContactSimulator:
         tangent = slope + bend * (first - d0)
         if not 0.5 * slope < tangent < 2.0 * slope:
             tangent = slope
-        for _ in range(self.PREDICTED_TRIALS - 1):
+        shrunk = False
+        for trial in range(2, self.PREDICTED_TRIALS_CONVERGING + 1):
             if abs(r) <= stop:
                 return x
+            if trial > self.PREDICTED_TRIALS and not shrunk:
+                return None
             x_new = x - r / tangent
-            if x_new == x:
+            if x_new == x or abs(x_new - x) * FOLD_SLOPE * glass > abs(r):
                 return None
             r_new = residual(x_new)
             if not self._attached():
@@ -1579,6 +1871,7 @@ class ContactSimulator:
             secant = (r_new - r) / (x_new - x)
             if not 0.25 * slope <= secant <= 4.0 * slope:
                 return None
+            shrunk = abs(r_new) <= 0.01 * abs(r)
             x, r, tangent = x_new, r_new, secant
         return x if abs(r) <= stop else None
 
@@ -1592,19 +1885,24 @@ class ContactSimulator:
         dt: float,
         hold_force: float | None,
         slope: float | None,
+        *,
+        converged: bool = False,
     ) -> None:
         """Keep what the next force step predicts its root from: the slope dF/dd at the root
         (from the trial nearest it, else `slope`), its change along the path since the step
         that ended in `before` (the output before this step), and the rate at which the force
         drifts at a held depth (from `hold_force`, the trial at the held depth d0, else
         extrapolated along the slope), tied to `output` (stale once the simulator's output
-        is another)."""
+        is another). An unstable output is not remembered unless `converged` (it met the
+        target)."""
         previous = self._force_memo
         if previous is not None and previous[0] is not before:
             previous = None
         self._force_memo = None
+        point = (output.time, output.depth, output.force)
+        path = (point,) if previous is None else (*previous[4][1 - PATH_POINTS :], point)
         root = output.depth
-        if output.unstable or output.contact_radius <= 0.0:
+        if (output.unstable and not converged) or output.contact_radius <= 0.0:
             return
         nearest = None
         for depth, force, radius in trials:
@@ -1623,7 +1921,7 @@ class ContactSimulator:
         if previous is not None and root != d0:
             bend = (slope - previous[1]) / (root - d0)
         if math.isfinite(drift_rate) and math.isfinite(bend):
-            self._force_memo = (output, slope, drift_rate, bend)
+            self._force_memo = (output, slope, drift_rate, bend, path)
 
     def _search_dip(
         self,
@@ -1631,6 +1929,9 @@ class ContactSimulator:
         trials: list[tuple[float, float, float]],
         target: float,
         stop: float,
+        *,
+        golden_section: bool = True,
+        detachment: bool = True,
     ) -> tuple[tuple[float, float, float, float] | None, float]:
         """A pull's bracketing steps reached a detached trial with every attached trial above
         the target: look for an attached force at or below the target between them (the
@@ -1644,12 +1945,16 @@ class ContactSimulator:
         drop within the bracket; only then is the detachment depth bisected, to 1e-13
         relative or to where the force cannot move by more than `stop` (N) across the
         interval. Both use the Lipschitz bound 2 x the glass stiffness 2 E0* a of the largest
-        contact tried (F(d) moves no faster under an instantaneous change of depth)."""
+        contact tried (F(d) moves no faster under an instantaneous change of depth).
+
+        `golden_section=False` skips the first part (a search before found no dip around
+        the same minimum), `detachment=False` the second (returns (None, nan): the steps
+        passed the minimum before they detached, see `_solve_force`)."""
         radius = max((r for _, _, r in trials), default=0.0)
         lipschitz = 4.0 * self.physics.e0 * radius
         samples = sorted(trials)
         attached = [i for i, (_, _, r) in enumerate(samples) if r > 0.0]
-        if attached:
+        if attached and golden_section:
             j = min(attached, key=lambda i: samples[i][1])
             a = samples[max(j - 1, 0)][0]
             b = samples[min(j + 1, len(samples) - 1)][0]
@@ -1689,6 +1994,8 @@ class ContactSimulator:
                     rd = value(d)
                     if rd <= 0.0:
                         return self._dip_bracket(trials, target, d, rd), math.nan
+        if not detachment:
+            return None, math.nan
         # No dip: bisect the detachment between the deepest detached trial shallower than
         # every attached one and the shallowest attached trial.
         hi = min((d for d, _, r in trials if r > 0.0), default=math.nan)
