@@ -19,6 +19,7 @@ guards the simulator against the services and parameter changes, which run on ex
 from __future__ import annotations
 
 import contextlib
+import gc
 import math
 import operator
 import sys
@@ -68,12 +69,23 @@ DIAGNOSTICS_PERIOD_S = 1.0
 #: Minimum interval between two warnings of the same kind of rejection (throttled log), s.
 WARN_THROTTLE_S = 1.0
 _QOS_DEPTH = 10
-#: Commands are taken reliable (the ROS default), so none is lost while discovery completes; a
-#: best-effort publisher (sensor-data QoS) cannot match it and is warned about (see
-#: ``_Contact.on_incompatible_qos``). A best-effort subscription would match both, but it lost
-#: the first command of a child-process client whose publisher matched before the node's
-#: subscription did.
-COMMAND_QOS = QoSProfile(depth=_QOS_DEPTH, reliability=ReliabilityPolicy.RELIABLE)
+
+
+def command_qos(depth: int) -> QoSProfile:
+    """QoS of the command subscriptions (``C/indentation``, ``hand/indentation``): reliable,
+    volatile, keep last ``depth`` (``command.queue_depth``).
+
+    Reliable (the ROS default), so no command is lost while discovery completes; a best-effort
+    publisher (sensor-data QoS) cannot match it and is warned about (see
+    ``_Contact.on_incompatible_qos``). A best-effort subscription would match both, but it lost
+    the first command of a child-process client whose publisher matched before the node's
+    subscription did. The depth is how far the live thread may fall behind before the oldest
+    waiting command is lost: 0.4.0's 10 (10 ms at 1 kHz) lost commands whenever the node
+    stalled longer (a full collection, the machine's scheduler; see benchmarks/rounds).
+    """
+    return QoSProfile(depth=depth, reliability=ReliabilityPolicy.RELIABLE)
+
+
 #: ``C/events`` keeps its last events for late joiners (a recorder started after the node).
 EVENTS_QOS = QoSProfile(
     depth=100, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL
@@ -150,7 +162,7 @@ class _Contact:
             IndentationCommand,
             f"{self.id}/indentation",
             self.on_command,
-            COMMAND_QOS,
+            node.command_qos,
             callback_group=live,
             event_callbacks=SubscriptionEventCallbacks(incompatible_qos=self.on_incompatible_qos),
         )
@@ -244,7 +256,8 @@ class _Contact:
         reason = (
             f"a publisher on {self.command_topic} offers a QoS incompatible with the node's (last "
             f"incompatible policy: {policy}); its commands are not received. The node subscribes "
-            "reliable, volatile, keep last 10: publish reliable (not best effort / sensor-data QoS)"
+            f"reliable, volatile, keep last {self.node.command_qos.depth}: publish reliable (not best "
+            "effort / sensor-data QoS)"
         )
         with self.lock:
             self.counters.incompatible_publishers = event.total_count
@@ -544,7 +557,7 @@ class _Hand:
             HandCommand,
             "hand/indentation",
             self.on_command,
-            COMMAND_QOS,
+            node.command_qos,
             callback_group=node.live_group,
             event_callbacks=SubscriptionEventCallbacks(incompatible_qos=self.on_incompatible_qos),
         )
@@ -871,6 +884,7 @@ class ViscoadhNode(Node):
         self.payloads = conversions.LivePayloads(self.frame_id)
         self.markers_enabled = self.scene.node.markers_enabled
         self.max_future_ns = round(self.scene.node.command_max_future_s * _NS_PER_S)
+        self.command_qos = command_qos(self.scene.node.command_queue_depth)
         # MCAP logging; None while logging is off. Opened before the endpoints exist, so the
         # log holds every command received and every state and wrench published.
         events_qos = TopicQos(depth=EVENTS_QOS.depth, durability="transient_local")
@@ -1050,6 +1064,18 @@ def _refuse(reason: str) -> SetParametersResult:
     return SetParametersResult(successful=False, reason=reason)
 
 
+def freeze_start_up_objects() -> None:
+    """Collect once, then move every object alive after start-up out of the collector's reach
+    (``gc.freeze``): rclpy, numba, numpy and the node's own objects (~10^5-10^6) are never
+    garbage, yet each full collection walked them all, stopping the live thread for 80-200 ms
+    (0.4.0 under 16 contacts x 1 kHz: about three a minute, measured with ``gc.callbacks``,
+    while the command queue held 10 ms of commands). The collector still runs, over what the
+    node creates afterwards. Called once per process, by :func:`main`, after the node is built
+    (a process that makes many nodes, such as the test suite, must not freeze their leftovers)."""
+    gc.collect()
+    gc.freeze()
+
+
 def main(args: list[str] | None = None) -> int:
     """Run the node until Ctrl-C or shutdown (console script ``viscoadh_node``).
 
@@ -1072,6 +1098,7 @@ def main(args: list[str] | None = None) -> int:
     node = None
     try:
         node = ViscoadhNode()
+        freeze_start_up_objects()
         executor = MultiThreadedExecutor()
         executor.add_node(node)
         while rclpy.ok() and node.live_error is None:
