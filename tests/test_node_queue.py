@@ -1,4 +1,4 @@
-"""The command queue (``command.queue_depth``) and the start-up freeze.
+"""The command queue (``command.queue_depth``), the raw hand-command take and the start-up freeze.
 
 A node whose live thread is held up (a full collection, a busy machine) must not lose the
 commands that arrive meanwhile, up to ``command.queue_depth`` per command topic; 0.4.0's fixed
@@ -7,6 +7,8 @@ depth of 10 lost every command beyond 10 ms of stall at 1 kHz.
 
 from __future__ import annotations
 
+import math
+import random
 import subprocess
 import sys
 import textwrap
@@ -19,6 +21,7 @@ import yaml
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import QoSProfile, ReliabilityPolicy
+from rclpy.serialization import serialize_message
 from viscoadh_msgs.msg import HandCommand
 
 from viscoadh_ros.core.config import (
@@ -29,6 +32,7 @@ from viscoadh_ros.core.config import (
     load_default_scene,
 )
 from viscoadh_ros.core.errors import ConfigError
+from viscoadh_ros.io import cdr
 from viscoadh_ros.ros.conversions import ns_to_stamp
 from viscoadh_ros.ros.node import ViscoadhNode
 
@@ -126,6 +130,54 @@ def test_a_held_up_live_thread_loses_no_command_within_the_queue_depth(
         assert served.commands_received == burst, f"{burst - served.commands_received} commands lost"
     else:
         assert served.commands_received <= depth + 2, served.commands_received
+
+
+def _hand_message(rng: random.Random) -> HandCommand:
+    msg = HandCommand()
+    msg.header.stamp.sec = rng.randrange(0, 2**31)
+    msg.header.stamp.nanosec = rng.randrange(0, 10**9)
+    msg.header.frame_id = "f" * rng.randrange(0, 9)
+    msg.contact_ids = [f"{'c' * rng.randrange(1, 7)}{k}" for k in range(rng.choice([0, 0, 1, 2, 3, 16]))]
+    msg.mode = rng.choice([0, 1, 7])
+    msg.depth = [rng.uniform(-1e-4, 1e-4) for _ in range(rng.choice([0, 1, 2, 3, 16]))]
+    msg.force = [rng.uniform(-1.0, 1.0) for _ in range(rng.choice([0, 1, 3, 16]))]
+    return msg
+
+
+def test_a_serialised_hand_command_reads_as_rclpy_reads_it() -> None:
+    rng = random.Random(13)
+    for _ in range(2000):
+        msg = _hand_message(rng)
+        payload = serialize_message(msg)
+        fields = cdr.parse_hand_command(payload)
+        stamp = msg.header.stamp
+        assert fields == (
+            stamp.sec,
+            stamp.nanosec,
+            tuple(msg.contact_ids),
+            msg.mode,
+            tuple(msg.depth),
+            tuple(msg.force),
+        )
+    special = HandCommand(
+        mode=HandCommand.DEPTH, depth=[math.inf, -math.nan, 0.0], contact_ids=["a", "b", "c"]
+    )
+    fields = cdr.parse_hand_command(serialize_message(special))
+    assert fields is not None and fields[4][0] == math.inf and math.isnan(fields[4][1])
+
+
+def test_a_cut_or_foreign_payload_is_left_to_rclpy() -> None:
+    rng = random.Random(5)
+    for _ in range(200):
+        payload = serialize_message(_hand_message(rng))
+        end = len(payload)
+        # Cut inside the fields (trailing bytes after the last one are the serializer's slack).
+        while end > 4 and cdr.parse_hand_command(payload[:end]) is not None:
+            end -= 1
+        for cut in range(0, end):
+            assert cdr.parse_hand_command(payload[:cut]) is None, cut
+        big_endian = b"\x00\x00" + payload[2:]
+        assert cdr.parse_hand_command(big_endian) is None
 
 
 def test_freezing_after_start_up_collects_first_then_freezes(tmp_path: Path) -> None:
