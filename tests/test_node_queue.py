@@ -7,6 +7,7 @@ depth of 10 lost every command beyond 10 ms of stall at 1 kHz.
 
 from __future__ import annotations
 
+import gc
 import math
 import random
 import subprocess
@@ -180,6 +181,13 @@ def test_a_cut_or_foreign_payload_is_left_to_rclpy() -> None:
         assert cdr.parse_hand_command(big_endian) is None
 
 
+def test_a_node_freezes_nothing_unless_asked(ros_context: Any) -> None:
+    frozen = gc.get_freeze_count()
+    node = _node(ros_context, _scene(1))
+    node.destroy_node()
+    assert gc.get_freeze_count() == frozen
+
+
 def test_freezing_after_start_up_collects_first_then_freezes(tmp_path: Path) -> None:
     """In a child process (a freeze is for the life of the process): garbage made before the
     call is collected, what is alive is frozen (out of every later collection)."""
@@ -201,6 +209,20 @@ def test_freezing_after_start_up_collects_first_then_freezes(tmp_path: Path) -> 
         freeze_start_up_objects()
         assert dead() is None, "garbage from before the freeze was frozen"
         assert gc.get_freeze_count() >= 1000, gc.get_freeze_count()
+        gc.enable()
+
+        # The node main() builds freezes what its start-up made, before its live thread runs.
+        import rclpy
+        from rclpy.context import Context
+        from viscoadh_ros.ros.node import ViscoadhNode
+
+        frozen = gc.get_freeze_count()
+        context = Context()
+        rclpy.init(context=context)
+        node = ViscoadhNode(context=context, freeze=True)
+        assert gc.get_freeze_count() > frozen, (gc.get_freeze_count(), frozen)
+        node.destroy_node()
+        context.try_shutdown()
         print("ok")
         """
     )

@@ -936,12 +936,14 @@ class _LiveLoop:
 
 class ViscoadhNode(Node):
     """The ``viscoadh`` node. Keyword arguments go to :class:`rclpy.node.Node` (``context``,
-    ``parameter_overrides``, ``namespace``, ...).
+    ``parameter_overrides``, ``namespace``, ...), except ``freeze``: when true, the objects
+    alive once the node is built are frozen (:func:`freeze_start_up_objects`) before its live
+    thread starts; for the one node of a process, as :func:`main` makes it.
 
     Raises ConfigError (naming the key) when the scene in the parameters is invalid.
     """
 
-    def __init__(self, **kwargs: Any) -> None:
+    def __init__(self, *, freeze: bool = False, **kwargs: Any) -> None:
         started = time.perf_counter()
         super().__init__(NODE_NAME, automatically_declare_parameters_from_overrides=True, **kwargs)
         self.scene: SceneConfig = parameters.scene_from_node(self)
@@ -976,6 +978,10 @@ class ViscoadhNode(Node):
         self.diagnostics_pub = self.create_publisher(DiagnosticArray, "/diagnostics", _QOS_DEPTH)
         self.create_timer(DIAGNOSTICS_PERIOD_S, self._publish_diagnostics)
         self._live = _LiveLoop(self)
+        if freeze:
+            # Before the live thread starts: the collection holds the GIL for 0.1-0.5 s (1e6
+            # objects, a loaded machine), which would stop the first commands.
+            freeze_start_up_objects()
         self._live.start()
         self.get_logger().info(
             f"ready in {time.perf_counter() - started:.3f} s (numba warm-up "
@@ -1133,11 +1139,12 @@ def _refuse(reason: str) -> SetParametersResult:
 def freeze_start_up_objects() -> None:
     """Collect once, then move every object alive after start-up out of the collector's reach
     (``gc.freeze``): rclpy, numba, numpy and the node's own objects (~10^5-10^6) are never
-    garbage, yet each full collection walked them all, stopping the live thread for 80-200 ms
-    (0.4.0 under 16 contacts x 1 kHz: about three a minute, measured with ``gc.callbacks``,
-    while the command queue held 10 ms of commands). The collector still runs, over what the
-    node creates afterwards. Called once per process, by :func:`main`, after the node is built
-    (a process that makes many nodes, such as the test suite, must not freeze their leftovers)."""
+    garbage, yet each full collection walked them all, stopping the live thread for 84-116 ms
+    (0.4.0 under 16 contacts x 1 kHz on the loaded bench machine: about one a minute, measured
+    with ``gc.callbacks``, while the command queue held 10 ms of commands). The collector still runs, over what the
+    node creates afterwards. Called once per process, by the node :func:`main` builds, before its
+    live thread starts (a process that makes many nodes, such as the test suite, must not freeze
+    their leftovers)."""
     gc.collect()
     gc.freeze()
 
@@ -1163,8 +1170,7 @@ def main(args: list[str] | None = None) -> int:
         return 2
     node = None
     try:
-        node = ViscoadhNode()
-        freeze_start_up_objects()
+        node = ViscoadhNode(freeze=True)
         executor = MultiThreadedExecutor()
         executor.add_node(node)
         while rclpy.ok() and node.live_error is None:
