@@ -191,7 +191,7 @@ class NodeConfig:
     log_max_duration: float = 0.0
     log_queue_size: int = 10000
     command_max_future_s: float = 1.0
-    command_queue_depth: int = 1000
+    command_queue_depth: int = 100
 
 
 #: Largest ``command.queue_depth``: 100 s of commands at 1 kHz.
