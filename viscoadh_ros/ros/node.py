@@ -1139,12 +1139,12 @@ def _refuse(reason: str) -> SetParametersResult:
 def freeze_start_up_objects() -> None:
     """Collect once, then move every object alive after start-up out of the collector's reach
     (``gc.freeze``): rclpy, numba, numpy and the node's own objects (~10^5-10^6) are never
-    garbage, yet each full collection walked them all, stopping the live thread for 84-116 ms
+    garbage, yet each full collection walked them all, stopping the live thread for 84-425 ms
     (0.4.0 under 16 contacts x 1 kHz on the loaded bench machine: about one a minute, measured
-    with ``gc.callbacks``, while the command queue held 10 ms of commands). The collector still runs, over what the
-    node creates afterwards. Called once per process, by the node :func:`main` builds, before its
-    live thread starts (a process that makes many nodes, such as the test suite, must not freeze
-    their leftovers)."""
+    with ``gc.callbacks``, while the command queue held 10 ms of commands). The collector still
+    runs, over what the node creates afterwards. Called once per process, by the node
+    :func:`main` builds, before its live thread starts (a process that makes many nodes, such
+    as the test suite, must not freeze their leftovers)."""
     gc.collect()
     gc.freeze()
 
