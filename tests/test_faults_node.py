@@ -284,7 +284,7 @@ def test_a_flood_is_served_or_shed_and_the_node_answers_after(
     served: tuple[subprocess.Popen, Controller, Path],
 ) -> None:
     """3000 commands as fast as this process publishes them: each is answered or lost in a
-    full queue (keep last 10), never more; then the node answers the next command."""
+    full queue (keep last command.queue_depth), never more; then the node answers the next command."""
     process, controller, _ = served
     controller.reset("soft")
     t0 = controller.now_ns() + AHEAD_NS

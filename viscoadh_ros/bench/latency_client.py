@@ -66,6 +66,8 @@ class _Client:
         self.pending: list[dict[int, int]] = [{} for _ in channels]
         self.last_stamp = [0] * len(channels)
         self.latency = np.full(samples, np.nan)
+        # Stamp (wall ns) of each sample's command: tells which commands a server's log holds.
+        self.stamps = np.zeros(samples, np.int64)
         self.answered = [False] * len(channels)
         self.first_reply_wall = math.nan
 
@@ -81,6 +83,8 @@ class _Client:
         msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(stamp, 1_000_000_000)
         if slot is not None:
             self.pending[contact][stamp] = slot
+            if slot != PROBE:
+                self.stamps[slot] = stamp
         self.publishers[contact].publish(msg)
 
     def serve_until(self, deadline: float) -> None:
@@ -165,6 +169,7 @@ def run_client(args: argparse.Namespace) -> int:
         send_lag_s=send_lag,
         latency_s=client.latency,
         first_reply_wall=client.first_reply_wall,
+        stamp_ns=client.stamps,
     )
     return 0
 

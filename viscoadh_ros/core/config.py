@@ -176,6 +176,9 @@ class NodeConfig:
     log_queue_size [log.queue_size]: bound of the writer queue, messages (> 0).
     command_max_future_s [command.max_future_s]: how far ahead of the node clock a command's
       ``header.stamp`` may be, s (>= 0); a command stamped further ahead is rejected.
+    command_queue_depth [command.queue_depth]: commands each command subscription
+      (``C/indentation``, ``hand/indentation``) holds for the live thread, keep last
+      (1..:data:`COMMAND_QUEUE_DEPTH_MAX`): a node that falls behind by more loses the oldest.
     """
 
     publish_rate: float = 50.0
@@ -188,7 +191,11 @@ class NodeConfig:
     log_max_duration: float = 0.0
     log_queue_size: int = 10000
     command_max_future_s: float = 1.0
+    command_queue_depth: int = 100
 
+
+#: Largest ``command.queue_depth``: 100 s of commands at 1 kHz.
+COMMAND_QUEUE_DEPTH_MAX = 100_000
 
 # --- schema: flat key -> (section dataclass field, kind) ------------------------------------
 
@@ -434,6 +441,11 @@ def _build_node(given: dict[str, Any]) -> NodeConfig:
         ("log.max_duration", node.log_max_duration >= 0.0, ">= 0"),
         ("log.queue_size", node.log_queue_size > 0, "> 0"),
         ("command.max_future_s", node.command_max_future_s >= 0.0, ">= 0"),
+        (
+            "command.queue_depth",
+            1 <= node.command_queue_depth <= COMMAND_QUEUE_DEPTH_MAX,
+            f"in 1..{COMMAND_QUEUE_DEPTH_MAX}",
+        ),
     ]
     for key, ok, bound in checks:
         if not ok:

@@ -156,6 +156,55 @@ def parse_command(payload: bytes) -> tuple[int, int, int, float, float] | None:
     return sec, nanosec, mode, depth, force
 
 
+HAND_COMMAND = "viscoadh_msgs/msg/HandCommand"
+_U32 = struct.Struct("<I")
+
+
+def parse_hand_command(
+    payload: bytes,
+) -> tuple[int, int, tuple[str, ...], int, tuple[float, ...], tuple[float, ...]] | None:
+    """``(stamp.sec, stamp.nanosec, contact_ids, mode, depth, force)`` of one serialised
+    HandCommand (the live path's raw take: a few microseconds for 16 contacts, against ~14 us
+    for rclpy's message object); None when it is not little-endian CDR of that layout, every
+    byte accounted for (the caller then falls back to rclpy)."""
+    size = len(payload)
+    if payload[:4] != _ENCAPSULATION or size < _HEADER + 12:
+        return None
+    try:
+        sec, nanosec, frame = _COMMAND_HEAD.unpack_from(payload, _HEADER)
+        position = 12 + frame  # from the end of the encapsulation header
+        position += -position % 4
+        (count,) = _U32.unpack_from(payload, _HEADER + position)
+        position += 4
+        if count > size:
+            return None
+        ids = []
+        for _ in range(count):
+            position += -position % 4
+            (length,) = _U32.unpack_from(payload, _HEADER + position)
+            start = _HEADER + position + 4
+            if length < 1 or start + length > size or payload[start + length - 1] != 0:
+                return None
+            ids.append(payload[start : start + length - 1].decode())
+            position += 4 + length
+        mode = payload[_HEADER + position]
+        position += 1
+        arrays = []
+        for _ in range(2):
+            position += -position % 4
+            (n,) = _U32.unpack_from(payload, _HEADER + position)
+            position += 4
+            if n:
+                position += -position % 8
+            if n > size or _HEADER + position + 8 * n > size:
+                return None
+            arrays.append(struct.unpack_from(f"<{n}d", payload, _HEADER + position))
+            position += 8 * n
+    except (struct.error, IndexError, UnicodeDecodeError):
+        return None
+    return sec, nanosec, tuple(ids), mode, arrays[0], arrays[1]
+
+
 def decode(
     type_name: str, payloads: Sequence[bytes] | NDArray[np.uint8], fields: Sequence[str] | None = None
 ) -> dict[str, NDArray] | None:

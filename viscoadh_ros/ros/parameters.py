@@ -30,7 +30,14 @@ from rcl_interfaces.msg import (
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
-from viscoadh_ros.core.config import CONTACT_KEYS, NODE_KEYS, SceneConfig, load_default_scene, read_yaml
+from viscoadh_ros.core.config import (
+    COMMAND_QUEUE_DEPTH_MAX,
+    CONTACT_KEYS,
+    NODE_KEYS,
+    SceneConfig,
+    load_default_scene,
+    read_yaml,
+)
 from viscoadh_ros.core.errors import ConfigError
 
 #: Parameters every rclpy node declares itself; they are not part of the scene.
@@ -163,6 +170,14 @@ _NODE_SPECS: dict[str, _Spec] = {
         "further ahead is rejected (it would move the contact's time).",
         low=0.0,
         high=_INF,
+    ),
+    "command.queue_depth": _Spec(
+        "Commands each command subscription (C/indentation, hand/indentation) holds for the "
+        "live thread, keep last: a node that falls behind by more loses the oldest. Fixed at "
+        "start-up.",
+        low=1,
+        high=COMMAND_QUEUE_DEPTH_MAX,
+        read_only=True,
     ),
     "log.enabled": _Spec("Record commands, states and wrenches to MCAP.", read_only=True),
     "log.path": _Spec("MCAP file or folder for the log.", read_only=True),
