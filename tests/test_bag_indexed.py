@@ -192,3 +192,48 @@ def test_a_bad_chunk_keeps_the_chunks_before_it(tmp_path: Path, damage: str) -> 
     assert kept == _contents(path, indexed=False, recover=True)
     count = sum(len(m[0]) for m in kept["messages"].values())
     assert 0 < count < 20000 and kept["truncated"] == [path]
+
+
+def _gathered_rows(bag: Bag, topic: str) -> np.ndarray:
+    """The (n, L) payloads of ``topic`` gathered one item per message (the reference for the
+    strided copies of `Bag.rows`)."""
+    info = bag._topics[topic]
+    width = int(info.column("sizes")[0])
+    items = [bag_module._unaligned(p.buffer, f"V{width}")[p.starts] for p in info.parts]
+    return np.concatenate(items).view(np.uint8).reshape(-1, width)
+
+
+@pytest.mark.parametrize("seconds", [0.001, 0.002, 0.5, 3.0])
+def test_rows_copied_in_runs_equal_the_gather(tmp_path: Path, seconds: float) -> None:
+    path = tmp_path / "stream.mcap"
+    record_stream(path, seconds)
+    bag = Bag(path)
+    for topic in bag.topics:
+        _, _, rows = bag.rows(topic)
+        assert rows is not None
+        np.testing.assert_array_equal(rows, _gathered_rows(bag, topic))
+
+
+def test_equal_spacing_runs() -> None:
+    runs = bag_module._equal_spacing_runs
+    assert runs(np.array([7]), 5) == [(0, 1, 5)]
+    assert runs(np.array([0, 10, 20, 30]), 5) == [(0, 4, 10)]
+    # A jump between chunks starts a new run; a lone start is a run of one.
+    starts = np.concatenate([np.arange(0, 1000, 10), [5000], np.arange(9000, 10000, 10)])
+    assert runs(starts, 5) == [(0, 100, 10), (100, 101, 5), (101, 201, 10)]
+    assert runs(np.array([0, 3, 6]), 5) is None  # spaced closer than a payload
+    assert runs(np.array([0, 10, 25, 27, 60, 61]), 1) is None  # irregular: gathered
+    # Whatever the layout, the copies equal the gather.
+    rng = np.random.default_rng(3)
+    buffer = rng.integers(0, 256, 20000, dtype=np.uint8)
+    for _ in range(20):
+        gaps = rng.choice([12, 12, 12, 12, 40], size=rng.integers(1, 300))
+        starts = np.cumsum(gaps) - gaps[0]
+        found = runs(starts, 12)
+        expected = bag_module._unaligned(buffer, "V12")[starts].view(np.uint8).reshape(-1, 12)
+        if found is None:
+            continue
+        copied = np.concatenate(
+            [np.ndarray((hi - lo, 12), np.uint8, buffer, int(starts[lo]), (s, 1)) for lo, hi, s in found]
+        )
+        np.testing.assert_array_equal(copied, expected)
