@@ -112,16 +112,33 @@ def _fill(
     first: int = 0,
 ) -> None:
     """Write messages ``first`` to ``first + len(records)`` of a topic as message records (a
-    zeroed structured array of :func:`_head_layout`) in place."""
-    end, length = first + len(records), _size(payloads)
+    zeroed structured array of :func:`_head_layout`) in place; messages given as columns
+    are checked first (`cdr.Messages.check`)."""
+    if isinstance(payloads, cdr.Messages):
+        payloads.check()
+    _fill_constant(records, channel, payloads)
+    _fill_varying(records, log_ns, payloads, first)
+
+
+def _fill_constant(records: np.ndarray, channel: int, payloads: NDArray[np.uint8] | cdr.Messages) -> None:
+    """The bytes all the records of a topic share (see `_fill`)."""
     records["opcode"] = Opcode.MESSAGE
-    records["length"] = _HEAD_SIZE - 9 + length
+    records["length"] = _HEAD_SIZE - 9 + _size(payloads)
     records["channel"] = channel
+    if isinstance(payloads, cdr.Messages):
+        payloads.encode_constant(records["data"].view(payloads.layout))
+
+
+def _fill_varying(
+    records: np.ndarray, log_ns: NDArray[np.int64], payloads: NDArray[np.uint8] | cdr.Messages, first: int
+) -> None:
+    """The bytes that differ between the records of a topic (see `_fill`)."""
+    end, length = first + len(records), _size(payloads)
     records["sequence"] = np.arange(first, end, dtype=np.uint32)
     records["log_time"] = log_ns[first:end]
     records["publish_time"] = log_ns[first:end]
     if isinstance(payloads, cdr.Messages):
-        payloads.encode_into(records["data"].view(payloads.layout), first)
+        payloads.encode_varying(records["data"].view(payloads.layout), first)
     elif length:
         records["data"] = payloads[first:end].view(f"V{length}").reshape(end - first)
 
@@ -171,6 +188,12 @@ class _SideBySide:
         self.which = np.tile(np.arange(count), n)
         self.times = np.repeat(log_ns, count)
         self._block = np.empty(0, self.row)
+        # One row of the bytes every row shares (record heads, encapsulations, frame ids,
+        # scalar fields; padding zero): a chunk's block starts as copies of it.
+        template = np.zeros(1, self.row)
+        for t, (name, data) in enumerate(zip(self.names, fixed, strict=True)):
+            _fill_constant(template[name], t + 1, data)
+        self._template = template.view(np.uint8)
 
     @staticmethod
     def plan(log_ns: list[NDArray[np.int64]], payloads: list[Any]) -> _SideBySide | None:
@@ -198,9 +221,9 @@ class _SideBySide:
             self._block = np.empty(k1 - k0, self.row)
         block = self._block[: k1 - k0]
         raw = block.view(np.uint8)
-        raw[:] = 0
-        for t, (name, data) in enumerate(zip(self.names, self.fixed, strict=True)):
-            _fill(block[name], t + 1, self.log_ns, data, k0)
+        raw.reshape(k1 - k0, self.row.itemsize)[:] = self._template
+        for name, data in zip(self.names, self.fixed, strict=True):
+            _fill_varying(block[name], self.log_ns, data, k0)
         offset = first - k0 * self.row.itemsize
         return memoryview(raw[offset : offset + end - first])
 
