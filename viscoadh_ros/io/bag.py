@@ -33,7 +33,6 @@ from mcap.opcode import Opcode
 from mcap.records import Channel, Chunk, Metadata, Schema
 from mcap.stream_reader import get_chunk_data_stream
 from numpy.typing import NDArray
-from rclpy.serialization import deserialize_message
 
 from viscoadh_ros.core.errors import InputError
 from viscoadh_ros.io.mcap_log import METADATA_NAME, SCENE_KEY, VERSION_KEY
@@ -505,6 +504,9 @@ class Bag:
                 (t, k, name, cls, data) for t, k, data in zip(log_ns, order, topic.payloads(), strict=True)
             )
         streams.sort(key=lambda item: (item[0], item[1]))
+        # rclpy only here: reading a replay's columns needs none (~50-150 ms of a fresh process).
+        from rclpy.serialization import deserialize_message
+
         for log_time, order, name, cls, data in streams:
             try:
                 msg = deserialize_message(data, cls)
