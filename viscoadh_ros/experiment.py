@@ -445,7 +445,8 @@ class ModelRun:
     model_force: NDArray[np.float64]  # (m,) N, at Experiment.measured_ns
     wall_time: float  # s spent simulating
     model: str  # ContactSimulator.model of the first input: "closed_form" or "time_stepped"
-    #: (n,) the model each input ran with (a PARAMETERS event may change it).
+    #: (n,) the model each input ran with when a PARAMETERS event changed it, else None
+    #: (every input ran with ``model``).
     input_model: NDArray[np.str_] | None = None
 
     @property
@@ -514,7 +515,7 @@ def run_model(
     kind, index, stamps = kind[sequence], index[sequence], stamps[sequence]
 
     columns = {name: np.empty(n, dtype=dtype) for name, dtype in _column_dtypes(STEP_OUTPUT_FIELDS).items()}
-    input_model = np.empty(n, dtype="<U16")
+    ran: list[tuple[NDArray[np.int64], str]] = []  # (inputs, the model they ran with) per piece
     model_force = np.empty(m)
     started = wallclock.perf_counter()
     # Pieces between restarts; each: measured samples before its first input (the node's hold
@@ -537,12 +538,18 @@ def run_model(
                 columns,
                 model_force,
             )
-            input_model[index[first:hi][kind[first:hi] == 0]] = model
+            ran.append((index[first:hi][kind[first:hi] == 0], model))
         if progress is not None:
             progress(int(hi - lo))
-    return ModelRun(
-        columns, model_force, wallclock.perf_counter() - started, str(input_model[0]), input_model
-    )
+    wall_time = wallclock.perf_counter() - started
+    # The model per input only when it changed (a 16-character string per input costs more
+    # than the rest of the bookkeeping).
+    input_model = None
+    if len({model for _, model in ran}) > 1:
+        input_model = np.empty(n, dtype="<U16")
+        for inputs, model in ran:
+            input_model[inputs] = model
+    return ModelRun(columns, model_force, wall_time, ran[0][1], input_model)
 
 
 def _at_rest(contact: ContactConfig, index: NDArray[np.int64], model_force: NDArray[np.float64]) -> None:
