@@ -638,7 +638,10 @@ def _depth_stretch(
         # case) and the inputs are consecutive: whole columns, no gather and scatter per field.
         at = slice(int(inputs[0]), int(inputs[0]) + count)
         for name, values in result.items():
-            columns[name][at] = values
+            if count == columns[name].size and values.dtype == columns[name].dtype:
+                columns[name] = values  # the whole column: step_depths' own array, no copy
+            else:
+                columns[name][at] = values
     else:
         for name, values in result.items():
             columns[name][inputs] = values[input_rows]

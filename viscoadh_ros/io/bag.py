@@ -136,30 +136,6 @@ def _unaligned(buffer: NDArray[np.uint8], dtype: str) -> NDArray:
     return np.ndarray((max(buffer.size - itemsize + 1, 0),), dtype, buffer, 0, (1,))
 
 
-def _equal_spacing_runs(starts: NDArray[np.int64], width: int) -> list[tuple[int, int, int]] | None:
-    """``starts`` (payloads of ``width`` bytes) cut into runs ``(lo, hi, spacing)``:
-    ``starts[lo:hi]`` equally spaced by ``spacing`` >= ``width`` bytes (one spacing for all,
-    the usual one; a run of one start takes ``width``); None when there would be more than one run
-    per 64 starts (then one gather costs less than the Python per run)."""
-    if starts.size < 2:
-        return [(0, int(starts.size), width)]
-    steps = np.diff(starts)
-    # The usual spacing: of the first, middle and last, the one most steps have.
-    spacing = max(
-        {int(steps[0]), int(steps[steps.size // 2]), int(steps[-1])},
-        key=lambda s: np.count_nonzero(steps == s),
-    )
-    if spacing < width:
-        return None
-    cuts = np.flatnonzero(steps != spacing) + 1
-    if cuts.size * 64 > starts.size:
-        return None
-    bounds = [0, *cuts.tolist(), int(starts.size)]
-    return [
-        (lo, hi, spacing if hi - lo > 1 else width) for lo, hi in zip(bounds[:-1], bounds[1:], strict=True)
-    ]
-
-
 def _message_indexes(data: bytes, position: int) -> list[tuple[int, int]]:
     """The (start, end) of the bodies of the complete message index records from
     ``position`` on (those that follow a chunk)."""
@@ -462,24 +438,15 @@ class Bag:
         if sizes.size == 0 or np.any(sizes != sizes[0]):
             return info.column("log_ns"), info.column("order"), None
         width = int(sizes[0])
-        # Each part's payloads straight into the (n, L) array: runs of payloads at equal
-        # spacing in its buffer (a chunk of a node log, where the topics' records take turns)
-        # as one strided copy each, else gathered as one L-byte item per message (an
-        # unaligned view of its buffer; numpy's per-item copy of those costs ~5x the strided).
+        # Each part's payloads gathered as one L-byte item per message (an unaligned view of
+        # its buffer), straight into the (n, L) array.
         rows = np.empty((sizes.size, width), np.uint8)
         items = rows.view(f"V{width}").reshape(sizes.size) if width else None
         done = 0
         for part in info.parts:
             count = part.starts.size
-            if items is not None and count:
-                runs = _equal_spacing_runs(part.starts, width)
-                if runs is None:
-                    items[done : done + count] = _unaligned(part.buffer, f"V{width}")[part.starts]
-                else:
-                    for lo, hi, spacing in runs:
-                        rows[done + lo : done + hi] = np.ndarray(
-                            (hi - lo, width), np.uint8, part.buffer, int(part.starts[lo]), (spacing, 1)
-                        )
+            if items is not None:
+                items[done : done + count] = _unaligned(part.buffer, f"V{width}")[part.starts]
             done += count
         return info.column("log_ns"), info.column("order"), rows
 
