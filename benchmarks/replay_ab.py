@@ -26,6 +26,7 @@ import subprocess
 import sys
 import tempfile
 import time
+from collections.abc import Callable
 from pathlib import Path
 from types import ModuleType
 from typing import Any
@@ -78,7 +79,9 @@ def current() -> dict[str, ModuleType]:
     return {name: importlib.import_module(f"viscoadh_ros.{name}") for name in MODULES}
 
 
-def stages(mods: dict[str, ModuleType], bag_path: Path, out: Path) -> dict[str, Any]:
+def stages(
+    mods: dict[str, ModuleType], bag_path: Path, out: Path, clock: Callable[[], float] = time.perf_counter
+) -> dict[str, Any]:
     """The verb's stages with one side's modules: each a callable on the same recording."""
     from viscoadh_ros.core.config import SceneConfig
 
@@ -94,11 +97,11 @@ def stages(mods: dict[str, ModuleType], bag_path: Path, out: Path) -> dict[str, 
     timed = replay.run_model
 
     def run_model(*args: Any, **kwargs: Any) -> Any:
-        start = time.perf_counter()
+        start = clock()
         try:
             return timed(*args, **kwargs)
         finally:
-            inner.append(time.perf_counter() - start)
+            inner.append(clock() - start)
 
     replay.run_model = run_model
 
@@ -130,7 +133,15 @@ def main() -> int:
     parser.add_argument("--new", help="a second ref in place of this checkout")
     parser.add_argument("--seconds", type=float, default=60.0)
     parser.add_argument("--repeats", type=int, default=8)
+    parser.add_argument(
+        "--clock",
+        choices=("wall", "cpu"),
+        default="wall",
+        help="wall: time.perf_counter; cpu: this thread's CPU time (time.thread_time: user and "
+        "system), which leaves out the time other processes hold the CPU (a loaded machine)",
+    )
     options = parser.parse_args()
+    clock = time.perf_counter if options.clock == "wall" else time.thread_time
 
     from viscoadh_ros.bench.replay_speed import record_stream
     from viscoadh_ros.core.simulator import ContactSimulator
@@ -140,11 +151,12 @@ def main() -> int:
         bag_path = folder / "stream.mcap"
         record_stream(bag_path, options.seconds)
         sides = {
-            "old": stages(load_old(options.ref, folder), bag_path, folder / "old.mcap"),
+            "old": stages(load_old(options.ref, folder), bag_path, folder / "old.mcap", clock),
             "new": stages(
                 current() if options.new is None else load_old(options.new, folder, "_ab_new"),
                 bag_path,
                 folder / "new.mcap",
+                clock,
             ),
         }
         experiment, contact = sides["new"]["_experiment"], sides["new"]["_contact"]
@@ -165,13 +177,13 @@ def main() -> int:
             for name in names:
                 order = ("old", "new") if repeat % 2 == 0 else ("new", "old")
                 for side in order:
-                    start = time.perf_counter()
+                    start = clock()
                     sides[side][name]()
-                    samples.setdefault((side, name), []).append(time.perf_counter() - start)
+                    samples.setdefault((side, name), []).append(clock() - start)
             for key, run in runs[2 * len(names) :]:
-                start = time.perf_counter()
+                start = clock()
                 run()
-                samples.setdefault(key, []).append(time.perf_counter() - start)
+                samples.setdefault(key, []).append(clock() - start)
         n = experiment.input_ns.size
         # Everything but the simulation, per whole run: its time less its own run_model's.
         for side in sides:
@@ -179,7 +191,10 @@ def main() -> int:
             samples[(side, "whole verb less its run_model")] = list(rest)
         names.append("whole verb less its run_model")
         med = {key: float(np.median(v)) / n * 1e6 for key, v in samples.items()}
-        print(f"{n} commands ({options.seconds:g} s at 1 kHz), median of {options.repeats}, us per command")
+        print(
+            f"{n} commands ({options.seconds:g} s at 1 kHz), median of {options.repeats}, us per command "
+            f"({options.clock} clock)"
+        )
         print(f"| stage | {options.ref} | {options.new or 'this checkout'} | ratio |")
         print("|---|---|---|---|")
         for name in names:

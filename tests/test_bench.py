@@ -383,6 +383,19 @@ def test_replay_speed_reports_stage_shares() -> None:
     # The reachable floor: the minimal stepper over the same history, plus replay's own cost.
     assert result["minimal_us_per_command"] > 0.0
     assert 0.0 < result["floor_realtime_factor"] < float("inf")
+    # A fresh process replays the same recording: slower than the warm run by its start-up.
+    assert result["fresh_process_s"] > result["fresh_process_start_s"] >= 0.0
+    assert result["fresh_process_realtime_factor"] == pytest.approx(
+        result["recorded_s"] / result["fresh_process_s"]
+    )
+    from viscoadh_ros.bench.report import render_markdown
+
+    text = render_markdown({"command": "c", "date": "d", "machine": "m", "replay": result}, None)
+    assert "A fresh `viscoadh replay` process" in text
+    del result["fresh_process_s"]  # results of an older run: rendered without the line
+    assert "A fresh" not in render_markdown(
+        {"command": "c", "date": "d", "machine": "m", "replay": result}, None
+    )
 
 
 def test_report_marks_targets() -> None:

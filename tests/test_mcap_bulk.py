@@ -112,3 +112,20 @@ def test_decode_only_the_fields_asked() -> None:
         np.testing.assert_array_equal(some[name], full[name])
     with pytest.raises(KeyError, match="no field"):
         cdr.decode(cdr.WRENCH, rows, ["wrench.force.w"])
+
+
+def test_crc32_combine_equals_zlib() -> None:
+    import random
+    import zlib
+
+    from viscoadh_ros.io.mcap_bulk import crc32_combine
+
+    rng = random.Random(5)
+    for first, second in [(0, 0), (0, 7), (7, 0), (1, 1), (100, 1000), (3, 1 << 20), (12345, 999_999)]:
+        a, b = rng.randbytes(first), rng.randbytes(second)
+        assert crc32_combine(zlib.crc32(a), zlib.crc32(b), second) == zlib.crc32(a + b)
+        start = rng.randrange(1 << 32)  # a CRC running on from earlier bytes
+        assert crc32_combine(zlib.crc32(a, start), zlib.crc32(b), second) == zlib.crc32(a + b, start)
+    # A wrong length gives another CRC (the shift is not a no-op).
+    a, b = rng.randbytes(50), rng.randbytes(60)
+    assert crc32_combine(zlib.crc32(a), zlib.crc32(b), 61) != zlib.crc32(a + b)

@@ -64,3 +64,17 @@ def test_run_model_equals_step_depths(tmp_path: Path, offset_ns: int) -> None:
     for name in STEP_OUTPUT_FIELDS:
         np.testing.assert_array_equal(run.input_columns[name], expected[name][input_rows], err_msg=name)
     np.testing.assert_array_equal(run.model_force, expected["force"][measured_rows])
+
+
+def test_running_max_and_last_true_equal_the_accumulates() -> None:
+    from viscoadh_ros.experiment import _last_true, _running_max
+
+    rng = np.random.default_rng(11)
+    for size in (0, 1, 2, 5, 200):
+        for values in (np.sort(rng.normal(size=size)), rng.normal(size=size), np.zeros(size)):
+            np.testing.assert_array_equal(_running_max(values), np.maximum.accumulate(values))
+        ints = rng.integers(-5, 5, size)
+        np.testing.assert_array_equal(_running_max(ints), np.maximum.accumulate(ints))
+        for mask in (rng.random(size) < 0.3, np.zeros(size, bool), np.ones(size, bool)):
+            expected = np.maximum.accumulate(np.where(mask, np.arange(size), -1)) if size else mask
+            np.testing.assert_array_equal(_last_true(mask), expected)

@@ -520,6 +520,16 @@ def render_markdown(results: dict[str, Any], figure: Path | None, notes: str | N
                 f"{_g(replay['floor_realtime_factor'])}x real time.",
                 "",
             ]
+        if "fresh_process_s" in replay:
+            lines += [
+                f"Those runs are warm (one process, imports and compiled code loaded before the "
+                f"timing). A fresh `viscoadh replay` process, what a user waits for, took "
+                f"{_g(replay['fresh_process_s'])} s from start to exit on the same recording: "
+                f"{_g(replay['fresh_process_realtime_factor'])}x real time, of which "
+                f"{_g(replay['fresh_process_start_s'])} s is start-up (interpreter, imports, the "
+                f"numba cache load) that the warm figure leaves out.",
+                "",
+            ]
         lines += _table(
             ["stage", "share of time"],
             [[stage, f"{share:.1%}"] for stage, share in replay["time_share"].items()],

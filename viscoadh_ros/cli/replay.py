@@ -221,13 +221,16 @@ def replay_one(args: argparse.Namespace, *, progress: bool = False) -> tuple[dic
     _, scene, experiment = open_experiment(args)
     contact = choose_contact(scene, args.contact, experiment.input_topic)
 
-    from tqdm import tqdm  # progress only on a terminal (tqdm disables itself otherwise)
+    if progress and sys.stderr.isatty():
+        # A bar on a terminal only (as tqdm's disable=None decides); tqdm is not imported
+        # otherwise (~10-100 ms of a fresh process).
+        from tqdm import tqdm
 
-    events = experiment.input_ns.size + experiment.measured_ns.size
-    with tqdm(
-        total=events, unit="step", file=sys.stderr, disable=None if progress else True, leave=False
-    ) as bar:
-        run = run_model(contact, experiment, progress=bar.update)
+        events = experiment.input_ns.size + experiment.measured_ns.size
+        with tqdm(total=events, unit="step", file=sys.stderr, leave=False) as bar:
+            run = run_model(contact, experiment, progress=bar.update)
+    else:
+        run = run_model(contact, experiment)
     summary = compare(experiment, run)
     _write_output(args.output, scene, contact.id, experiment, run)
     result = {

@@ -33,7 +33,6 @@ from mcap.opcode import Opcode
 from mcap.records import Channel, Chunk, Metadata, Schema
 from mcap.stream_reader import get_chunk_data_stream
 from numpy.typing import NDArray
-from rclpy.serialization import deserialize_message
 
 from viscoadh_ros.core.errors import InputError
 from viscoadh_ros.io.mcap_log import METADATA_NAME, SCENE_KEY, VERSION_KEY
@@ -154,11 +153,12 @@ def _message_indexes(data: bytes, position: int) -> list[tuple[int, int]]:
 
 def _indexed_starts(
     data: bytes, buffer: NDArray[np.uint8], indexes: list[tuple[int, int]]
-) -> NDArray[np.int64] | None:
-    """The offsets of a chunk's message records (``buffer``: its records) from its message
-    indexes (bodies at ``indexes`` in ``data``), in record order; None unless those records
-    tile the chunk exactly: the first at 0, each next one where the one before ends, the last
-    ending at the chunk's end, every one a message record (then the walk finds the same)."""
+) -> tuple[NDArray[np.int64], NDArray[np.int64]] | None:
+    """``(starts, lengths)``: the offsets of a chunk's message records (``buffer``: its
+    records) from its message indexes (bodies at ``indexes`` in ``data``), in record order,
+    and each record's length field; None unless those records tile the chunk exactly: the
+    first at 0, each next one where the one before ends, the last ending at the chunk's end,
+    every one a message record (then the walk finds the same)."""
     offsets = []
     for start, end in indexes:
         if end - start < 6:
@@ -177,10 +177,11 @@ def _indexed_starts(
         return None
     if np.any(buffer[starts] != Opcode.MESSAGE):
         return None
-    ends = starts + _RECORD_HEADER.size + _unaligned(buffer, "<u8")[starts + 1].astype(np.int64)
+    lengths = _unaligned(buffer, "<u8")[starts + 1].astype(np.int64)
+    ends = starts + _RECORD_HEADER.size + lengths
     if ends[-1] != buffer.size or np.any(ends[:-1] != starts[1:]):
         return None
-    return starts
+    return starts, lengths
 
 
 class Bag:
@@ -217,7 +218,8 @@ class Bag:
         # (`_flush`) before anything that could change what they mean (a channel or schema
         # record) and at the end.
         self._buffer = np.frombuffer(data, np.uint8)
-        self._pending: list[NDArray[np.int64]] = []
+        # (file offsets of message records, their length fields when already read, else None)
+        self._pending: list[tuple[NDArray[np.int64], NDArray[np.int64] | None]] = []
         finished = False
         try:
             position, length = len(_MAGIC), len(data)
@@ -233,7 +235,7 @@ class Bag:
                     indexes = _message_indexes(data, position) if self.use_indexes else []
                     self._read_chunk(data, start, position, indexes, channels, schemas)
                 elif opcode == Opcode.MESSAGE:
-                    self._pending.append(np.array([start - _RECORD_HEADER.size]))
+                    self._pending.append((np.array([start - _RECORD_HEADER.size]), None))
                 elif opcode in _RECORD_TYPES:
                     if opcode != Opcode.METADATA:
                         self._flush(channels, schemas)
@@ -293,9 +295,9 @@ class Bag:
             if len(records) != uncompressed:
                 raise McapError("chunk size differs from its uncompressed size")
         buffer = np.frombuffer(records, np.uint8)
-        starts = _indexed_starts(data, buffer, indexes) if indexes else None
-        if starts is not None:
-            self._messages(compression, body_start, buffer, starts, channels, schemas)
+        located = _indexed_starts(data, buffer, indexes) if indexes else None
+        if located is not None:
+            self._messages(compression, body_start, buffer, located[0], channels, schemas, located[1])
             return
         length = len(records)
         found: list[int] = []  # starts of the message records
@@ -331,13 +333,15 @@ class Bag:
         starts: NDArray[np.int64],
         channels: dict[int, Channel],
         schemas: dict[int, Schema],
+        lengths: NDArray[np.int64] | None = None,
     ) -> None:
-        """Message records at ``starts`` of a chunk's records ``buffer``: added now from a
-        decompressed buffer, else kept as file offsets for `_flush`."""
+        """Message records at ``starts`` of a chunk's records ``buffer`` (``lengths``: their
+        length fields, when read already): added now from a decompressed buffer, else kept as
+        file offsets for `_flush`."""
         if compression:
-            self._add_messages(buffer, starts, channels, schemas)
+            self._add_messages(buffer, starts, channels, schemas, lengths)
         else:
-            self._pending.append(starts + body_start)
+            self._pending.append((starts + body_start, lengths))
 
     def _flush(self, channels: dict[int, Channel], schemas: dict[int, Schema]) -> None:
         """Add the pending message records of the file in one pass; when that fails (a bad
@@ -345,11 +349,14 @@ class Bag:
         batch, self._pending = self._pending, []
         if not batch:
             return
+        starts = np.concatenate([s for s, _ in batch])
+        known = [n for _, n in batch]
+        lengths = None if any(n is None for n in known) else np.concatenate(known)
         try:
-            self._add_messages(self._buffer, np.concatenate(batch), channels, schemas)
+            self._add_messages(self._buffer, starts, channels, schemas, lengths)
         except McapError:
-            for starts in batch:
-                self._add_messages(self._buffer, starts, channels, schemas)
+            for part_starts, part_lengths in batch:
+                self._add_messages(self._buffer, part_starts, channels, schemas, part_lengths)
 
     def _add_messages(
         self,
@@ -357,15 +364,18 @@ class Bag:
         starts: NDArray[np.int64],
         channels: dict[int, Channel],
         schemas: dict[int, Schema],
+        lengths: NDArray[np.int64] | None = None,
     ) -> None:
-        """Message records at ``starts`` of ``buffer``, as columns per topic, in order."""
+        """Message records at ``starts`` of ``buffer``, as columns per topic, in order
+        (``lengths``: their length fields when read already, else read here)."""
         # Every record lies whole in ``buffer`` (its caller checked its length), so the
         # fields after the opcode are read as unaligned numbers at the records' offsets.
-        record_size = _unaligned(buffer, "<u8")[starts + 1].astype(np.int64)
+        record_size = _unaligned(buffer, "<u8")[starts + 1].astype(np.int64) if lengths is None else lengths
         if np.any(record_size < _MESSAGE_FIELDS.size):
             raise McapError("a message record shorter than its fields")
         channel_id = _unaligned(buffer, "<u2")[starts + 9]
-        ids = np.unique(channel_id).tolist()
+        # The channels present, ascending (a count per id: no sort of the records).
+        ids = np.flatnonzero(np.bincount(channel_id)).tolist() if channel_id.size else []
         unknown = [cid for cid in ids if cid not in channels]
         if unknown:  # before anything is added
             raise McapError(f"message on channel {unknown[0]}, which is not defined before it")
@@ -472,6 +482,9 @@ class Bag:
                 (t, k, name, cls, data) for t, k, data in zip(log_ns, order, topic.payloads(), strict=True)
             )
         streams.sort(key=lambda item: (item[0], item[1]))
+        # rclpy only here: reading a replay's columns needs none (~50-150 ms of a fresh process).
+        from rclpy.serialization import deserialize_message
+
         for log_time, order, name, cls, data in streams:
             try:
                 msg = deserialize_message(data, cls)

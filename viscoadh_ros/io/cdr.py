@@ -68,6 +68,7 @@ WRENCH = "geometry_msgs/msg/WrenchStamped"
 TYPES = frozenset(_FIELDS)
 
 
+@functools.lru_cache(maxsize=64)
 def _layout(type_name: str, frame_bytes: int) -> np.dtype:
     """Structured dtype of one serialised message whose ``frame_id`` has ``frame_bytes`` bytes
     (without its NUL); fields at their CDR offsets, itemsize = the serialised size."""
@@ -306,17 +307,35 @@ class Messages:
         (k,), dtype :attr:`layout`, any strides, every byte zero beforehand (padding and
         fields not given stay zero). Checks (:meth:`check`) before writing."""
         self.check()
-        end = first + len(records)
-        frame = self.frame_id.encode()
-        stamps = np.asarray(self.stamp_ns, dtype=np.int64)[first:end]
+        self.encode_constant(records)
+        self.encode_varying(records, first)
+
+    def encode_constant(self, records: np.ndarray) -> None:
+        """The bytes every message of the batch shares (the encapsulation, the frame id, the
+        fields given as scalars) into ``records`` (as :meth:`encode_into`; a writer that
+        fills one template row and copies it needs this once, not once per message)."""
         records["encapsulation"] = np.void(_ENCAPSULATION)
         if _FIELDS[self.type_name][0]:
-            records["stamp.sec"], records["stamp.nanosec"] = np.divmod(stamps, 1_000_000_000)
+            frame = self.frame_id.encode()
             records["frame_id.length"] = len(frame) + 1
             records["frame_id"] = frame
         for name, values in self.fields.items():
             values = np.asarray(values)
-            records[name] = values[first:end] if values.ndim else values
+            if not values.ndim:
+                records[name] = values
+
+    def encode_varying(self, records: np.ndarray, first: int = 0) -> None:
+        """The bytes that differ between messages (the stamps, the fields given as arrays) of
+        messages ``first`` to ``first + len(records)`` into ``records``; with
+        :meth:`encode_constant` (before or after) this is :meth:`encode_into`, unchecked."""
+        end = first + len(records)
+        if _FIELDS[self.type_name][0]:
+            stamps = np.asarray(self.stamp_ns, dtype=np.int64)[first:end]
+            records["stamp.sec"], records["stamp.nanosec"] = np.divmod(stamps, 1_000_000_000)
+        for name, values in self.fields.items():
+            values = np.asarray(values)
+            if values.ndim:
+                records[name] = values[first:end]
 
 
 HAND_STATE = "viscoadh_msgs/msg/HandState"

@@ -46,7 +46,6 @@ from mcap.records import (
     SummaryOffset,
 )
 from numpy.typing import NDArray
-from rclpy.serialization import serialize_message
 
 from viscoadh_ros import __version__
 from viscoadh_ros.core.errors import ConfigError
@@ -69,6 +68,17 @@ _MAGIC = b"\x89MCAP0\r\n"
 
 # rmw's RMW_DURATION_INFINITE as rosbag2 Jazzy writes it ({sec, nsec} of INT64_MAX ns).
 _INFINITE = {"sec": 9223372036, "nsec": 854775807}
+
+
+def serialize_message(msg: Any) -> bytes:
+    """``rclpy.serialization.serialize_message``, imported on first use (then this module's
+    name is bound to it, so later calls go straight to rclpy): the readers and the columnar
+    writer that import this module for its records and constants need no rclpy (~50-150 ms
+    of a fresh process)."""
+    from rclpy.serialization import serialize_message as serialize
+
+    globals()["serialize_message"] = serialize
+    return serialize(msg)
 
 
 @dataclass(frozen=True)
