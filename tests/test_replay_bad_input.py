@@ -68,3 +68,51 @@ def test_bad_recording_gives_one_line(
     assert len(lines) == 1 and lines[0].startswith(f"viscoadh {verb}: error:"), f"{case}: {err!r}"
     assert expected in lines[0], f"{case}: {lines[0]!r}"
     assert not out.exists(), f"{case}: nothing may be written"
+
+
+def _hand_log(path: Path, hand_ids: list[str]) -> Path:
+    """A node-style log of contact ``finger``: its own commands on ``finger/indentation`` and
+    ``finger/wrench`` answers, and in the middle hand commands naming ``hand_ids``."""
+    from geometry_msgs.msg import WrenchStamped as Wrench
+    from viscoadh_msgs.msg import HandCommand, IndentationCommand
+
+    from viscoadh_ros.ros.conversions import ns_to_stamp
+
+    t0 = 5_000_000_000
+    with McapRecorder(path, scene={"contacts": ["finger", "thumb"]}) as recorder:
+        for i in range(60):
+            ns = t0 + i * 1_000_000
+            if 20 <= i < 40:
+                hand = HandCommand(contact_ids=hand_ids, mode=0, depth=[i * 1e-7] * len(hand_ids))
+                hand.header.stamp = ns_to_stamp(ns)
+                recorder.record("/hand/indentation", hand, ns + 100)
+            else:
+                command = IndentationCommand(mode=0, depth=i * 1e-7)
+                command.header.stamp = ns_to_stamp(ns)
+                recorder.record("/finger/indentation", command, ns + 100)
+            wrench = Wrench()
+            wrench.header.stamp = ns_to_stamp(ns)
+            recorder.record("/finger/wrench", wrench, ns + 200)
+    return path
+
+
+def test_a_contact_stepped_by_hand_commands_is_refused_not_replayed_wrong(tmp_path: Path, capsys) -> None:
+    """Found by an outside tester (benchmarks/outside_test_0.5.0/node_hand_log.py): a node log
+    whose contact took a third of its commands from hand/indentation replayed with exit 0 and a
+    wrong model (replay reads C/indentation only). Now refused, naming the hand topic; a hand
+    command of other contacts only does not stand in the way."""
+    from viscoadh_ros.core.errors import InputError
+    from viscoadh_ros.experiment import load_experiment
+    from viscoadh_ros.io.bag import Bag
+
+    driven = _hand_log(tmp_path / "driven.mcap", ["thumb", "finger"])
+    with pytest.raises(
+        InputError, match=r"'finger' was also stepped by hand commands \(20 on '/hand/indentation'\)"
+    ):
+        load_experiment(Bag(driven), contact="finger")
+    assert main(["replay", str(driven), "-o", str(tmp_path / "out.mcap"), "--contact", "finger"]) != 0
+    assert "hand commands" in capsys.readouterr().err
+    assert not (tmp_path / "out.mcap").exists()
+    others = _hand_log(tmp_path / "others.mcap", ["thumb"])
+    experiment = load_experiment(Bag(others), contact="finger")
+    assert experiment.input_ns.size == 40
