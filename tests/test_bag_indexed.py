@@ -16,6 +16,7 @@ from viscoadh_ros.bench.replay_speed import record_stream
 from viscoadh_ros.io import bag as bag_module
 from viscoadh_ros.io import cdr
 from viscoadh_ros.io.bag import Bag
+from viscoadh_ros.io.mcap_log import McapRecorder
 
 
 def _contents(path: Path, *, indexed: bool, recover: bool = False) -> dict[str, Any]:
@@ -192,3 +193,27 @@ def test_a_bad_chunk_keeps_the_chunks_before_it(tmp_path: Path, damage: str) -> 
     assert kept == _contents(path, indexed=False, recover=True)
     count = sum(len(m[0]) for m in kept["messages"].values())
     assert 0 < count < 20000 and kept["truncated"] == [path]
+
+
+def test_recover_with_nothing_recoverable_says_so(tmp_path: Path) -> None:
+    """A file cut inside its first chunk: --recover has no message to give, and says that
+    (an outside tester saw "no input topic", which sent them looking for a topic problem)."""
+    from geometry_msgs.msg import PointStamped
+
+    from viscoadh_ros.cli.main import main
+    from viscoadh_ros.core.errors import InputError
+
+    whole = tmp_path / "whole.mcap"
+    with McapRecorder(whole) as recorder:
+        for i in range(50):
+            point = PointStamped()
+            point.point.z = i * 1e-7
+            recorder.record("/probe/depth", point, 1_000_000_000 + i * 1_000_000)
+    data = whole.read_bytes()
+    cut = tmp_path / "cut.mcap"
+    cut.write_bytes(data[: 8 + (len(data) - 8) // 10])  # the magic and a tenth of the records
+    with pytest.raises(InputError, match="nothing to recover"):
+        Bag(cut, recover=True)
+    with pytest.raises(InputError, match="truncated or damaged"):
+        Bag(cut)
+    assert main(["replay", str(cut), "-o", str(tmp_path / "out.mcap"), "--recover"]) != 0

@@ -206,6 +206,12 @@ class Bag:
         self._records = 0
         for file in self.files:
             self._read_file(file, recover)
+        if self.truncated and self._records == 0:
+            names = ", ".join(repr(str(f)) for f in self.truncated)
+            raise InputError(
+                f"nothing to recover from {names}: the file ends or is damaged before its first "
+                "complete chunk, so no message in it can be read"
+            )
 
     def _read_file(self, file: Path, recover: bool) -> None:
         schemas: dict[int, Schema] = {}
