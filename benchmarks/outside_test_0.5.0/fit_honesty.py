@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "tests"))
 from fit_records import TRUE, scene, standard_history, true_force, write_record  # noqa: E402
 
 from viscoadh_ros.fitting import fit_file  # noqa: E402

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "tests"))
 from fit_records import scene, standard_history, true_force, write_record  # noqa: E402
 
 from viscoadh_ros.bench.fit_speed import KELVIN2  # noqa: E402

@@ -10,7 +10,7 @@ from pathlib import Path
 from geometry_msgs.msg import PointStamped, WrenchStamped
 from std_msgs.msg import String
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "tests"))
 from fit_records import TRUE, scene, standard_history, true_force  # noqa: E402
 
 from viscoadh_ros.io.mcap_log import McapRecorder, plain  # noqa: E402
