@@ -22,7 +22,7 @@ CALLS = 2000
 
 
 @numba.njit(nogil=True)
-def _args31(wl, wsum, wb, bsum, scratch, scratch_b, diss, dx, g_c, gf, gint, gmin, gmax, df, e0, c_crit,
+def _args32(wl, wsum, wb, bsum, scratch, scratch_b, diss, coef, dx, g_c, gf, gint, gmin, gmax, df, e0, c_crit,
             reach, p, p_inv, lam, beta, rate, kap, e_kelvin, out, a, d0, d1, dt, ms, me):  # fmt: skip
     out[0] = a + wl.shape[0]
     return 0
@@ -35,7 +35,7 @@ def _tuple(args, a, d0, d1, dt, ms, me):
 
 
 @numba.njit(nogil=True)
-def _arrays_and_scalar_array(wl, wsum, wb, bsum, scratch, scratch_b, diss, g_c, gf, gint, gmin, gmax, p,
+def _arrays_and_scalar_array(wl, wsum, wb, bsum, scratch, scratch_b, diss, coef, g_c, gf, gint, gmin, gmax, p,
                              p_inv, lam, beta, rate, e_kelvin, out, scalars):  # fmt: skip
     out[0] = scalars[0]
     return 0
@@ -96,13 +96,13 @@ def main() -> None:
         return run
 
     options = {
-        "31 arguments (19 arrays, 12 floats): _advance's signature": loop(
-            lambda: _args31(*args, 1.0, 2.0, 3.0, 1e-3, 0.0, 1e-6)
+        "32 arguments (20 arrays, 12 floats): _advance's signature": loop(
+            lambda: _args32(*args, 1.0, 2.0, 3.0, 1e-3, 0.0, 1e-6)
         ),
-        "the row's 25 arguments as one tuple + 6 floats": loop(
+        "the row's 26 arguments as one tuple + 6 floats": loop(
             lambda: _tuple(args, 1.0, 2.0, 3.0, 1e-3, 0.0, 1e-6)
         ),
-        "19 arrays + the scalars packed in one array": loop(
+        "20 arrays + the scalars packed in one array": loop(
             lambda: _arrays_and_scalar_array(*arrays, scalars)
         ),
         "2 buffers + the scalars packed in one array (3 writes)": loop(

@@ -2710,6 +2710,103 @@ def _advance_packed(state, const, journal, a, d0, d1, dt, max_substep, max_edge_
     return _advance_from(*args, a, d0, d1, dt, max_substep, max_edge_move, force_prev)
 
 
+#: Phase codes `_step_packed` returns (the values of `simulator.Phase`).
+PHASE_NO_CONTACT, PHASE_INDENTING, PHASE_STICKING, PHASE_DETACHING = 0, 1, 2, 3
+
+
+# With the runtime, like `_advance_packed` (the views `_unpack` makes carry no reference
+# count). Its return value is a tuple of scalars: boxing it costs less than reading the same
+# values back from ``out`` in Python.
+@numba.njit(cache=True, nogil=True)
+def _step_packed(
+    state, const, journal, a, d0, d1, dt, max_substep, max_edge_cells, force_prev, r0, e_relaxed, v_c1, v_c2
+):
+    """`_advance_packed` (`journal`, `a` .. `dt`, `max_substep`, `force_prev` as there), the
+    edge limit given as ``max_edge_cells`` elements of this row, then the step's derived
+    outputs from the kernel's ``out`` slots, computed as `simulator._phase` and
+    `ContactSimulator.step` computed them in Python (the same IEEE operations in the same
+    order: the same bits). The simulator's one kernel call per step or force trial.
+
+    r0: the contact radius before the step (the last output's), m; e_relaxed: the relaxed
+    modulus E_r*, Pa; v_c1, v_c2: the critical edge speeds (advancing, receding), m/s.
+
+    Returns ``(status, radius, force, work, substeps, dissipated, memory_peak, (gap_outside,
+    gap_inside, g_edge), phase, edge_speed, effective_work, scale_separation_ok)``: the
+    ``out`` slots (``dissipated``: over this step), the phase code (``PHASE_*``), and, when
+    status is not STATUS_OK, outputs of a partial step that the caller discards (it
+    restores the memory from the journal)."""
+    args, txn, txn_b = _unpack(state, const)
+    if journal:
+        _copy_state(args[0], args[2], txn, txn_b)
+    dx = const[4]
+    max_edge_move = max_edge_cells * dx
+    if math.isnan(force_prev):
+        status = _advance(*args, a, d0, d1, dt, max_substep, max_edge_move)
+    else:
+        status = _advance_from(*args, a, d0, d1, dt, max_substep, max_edge_move, force_prev)
+    out = args[25]
+    radius = out[OUT_RADIUS]
+    outside = out[OUT_GAP_OUTSIDE]
+    inside = out[OUT_GAP_INSIDE]
+    g_edge = out[OUT_G_EDGE] if radius > 0.0 else 0.0
+    # `simulator._phase`: an edge that moved less than twice its location tolerance is at rest.
+    if radius <= 0.0:
+        phase = PHASE_NO_CONTACT
+    else:
+        rest = 2.0 * EDGE_TOLERANCE * dx
+        if radius > r0 + rest:
+            phase = PHASE_INDENTING
+        elif radius < r0 - rest:
+            phase = PHASE_DETACHING
+        else:
+            tol = 1e-9 * (abs(d1) + const[7] * math.sqrt(radius) + g_edge)
+            if outside >= -tol:
+                phase = PHASE_INDENTING
+            elif inside <= tol:
+                phase = PHASE_DETACHING
+            else:
+                phase = PHASE_STICKING
+    edge_speed = (radius - r0) / dt if dt > 0.0 else 0.0
+    u = d1 - g_edge
+    if radius > 0.0 and u < 0.0:
+        effective = e_relaxed * u * u / (2.0 * math.pi * radius)
+    else:
+        effective = 0.0
+    if edge_speed == 0.0:
+        separated = True
+    else:
+        separated = abs(edge_speed) >= (v_c1 if edge_speed > 0.0 else v_c2)
+    return (
+        status,
+        radius,
+        out[OUT_FORCE],
+        out[OUT_WORK],
+        int(out[OUT_SUBSTEPS]),
+        out[OUT_DISSIPATED],
+        out[OUT_MEMORY],
+        (outside, inside, out[OUT_G_EDGE]),
+        phase,
+        edge_speed,
+        effective,
+        separated,
+    )
+
+
+#: `_step_packed`'s argument types: its one compiled version, whose entry point
+#: (`step_entry`) the simulator calls directly.
+_STEP_SIGNATURE = (types.float64[::1], types.float64[::1], types.boolean) + (types.float64,) * 11
+
+
+@functools.cache
+def step_entry():
+    """`_step_packed`'s compiled entry point for `_STEP_SIGNATURE`, called without numba's
+    dispatcher: the dispatcher types every argument to pick the version (about 0.6 us per
+    call with 13 arguments, measured side by side with `benchmarks/dispatch_options.py`);
+    the entry point only unboxes them. The caller must pass exactly these types (two
+    C-contiguous float64 arrays, a bool, then 11 floats): nothing checks them."""
+    return _step_packed.compile(_STEP_SIGNATURE)
+
+
 class Row:
     """The preallocated arrays of one MDR row, its chain's modal data and constants.
 
@@ -3187,9 +3284,11 @@ def warm_up() -> None:
     # The simulator's transaction journal and force-search restores call these from Python.
     _copy_state(row.wl, row.wb, row.txn, row.txn_b)
     _restore_state(row.wl, row.wsum, row.wb, row.bsum, row.txn, row.txn_b)
-    # The simulator's step calls the kernel through its two buffers.
-    _advance_packed(row._state, row._const, True, 0.0, 0.0, 0.1, 0.01, 0.0, 0.25, math.nan)
-    _advance_packed(row._state, row._const, False, 0.0, 0.0, 0.1, 0.01, 0.0, 0.25, 0.0)
+    # The simulator's step calls the kernel through its two buffers (`_step_packed`'s entry
+    # point; `_advance_packed`, the same without the derived outputs, is the benchmarks').
+    step = step_entry()
+    step(row._state, row._const, True, 0.0, 0.0, 0.1, 0.01, 0.0, 1.0, math.nan, 0.0, 1.0, 1.0, 1.0)
+    step(row._state, row._const, False, 0.0, 0.0, 0.1, 0.01, 0.0, 1.0, 0.0, 0.0, 1.0, 1.0, 1.0)
     _restore_state(row.wl, row.wsum, row.wb, row.bsum, row.txn, row.txn_b)
     _g_at(0.3, row.gf, row.df)
     stored_energy(row, 0.3, 0.1)
