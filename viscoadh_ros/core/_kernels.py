@@ -46,6 +46,7 @@ from __future__ import annotations
 
 import functools
 import math
+from typing import Any
 
 import numba
 import numpy as np
@@ -2530,6 +2531,8 @@ def _const_layout(n: int, k: int, m: int, blocks: int) -> tuple[tuple[str, tuple
 
 
 _VIEW_NAMES = frozenset(name for name, _ in _state_layout(1, 1) + _const_layout(1, 1, 2, 1))
+#: What a pickled (or deep-copied) row leaves behind: the views and the buffers' addresses.
+_NOT_PICKLED = _VIEW_NAMES | {"addresses"}
 
 
 def _arena_size(layout: tuple[tuple[str, tuple[int, ...]], ...], start: int) -> int:
@@ -2599,13 +2602,19 @@ def _unpack(state, const):
     """The row's kernel arguments (as `Row.kernel_args`) and its journal (txn, txn_b) as
     views of its two buffers (`_state_layout`, `_const_layout`, the header). The views do not
     keep the buffers alive: use them only inside the call that received the buffers."""
+    return _unpack_at(state.ctypes.data, const.ctypes.data)
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _unpack_at(s, c):
+    """`_unpack` of the buffers at addresses `s` (`Row._state`) and `c` (`Row._const`)
+    (`Row.addresses`): the caller holds the buffers for the whole call."""
+    const = _view(c, 0, PACK_HEADER)
     n = int(const[0])
     k = int(const[1])
     m = int(const[2])
     blocks = int(const[3])
     nk = n * k
-    s = state.ctypes.data
-    c = const.ctypes.data
     o = 0
     wl = _view(s, o, (n, k))
     o += nk
@@ -2721,11 +2730,14 @@ PHASE_NO_CONTACT, PHASE_INDENTING, PHASE_STICKING, PHASE_DETACHING = 0, 1, 2, 3
 def _step_packed(
     state, const, journal, a, d0, d1, dt, max_substep, max_edge_cells, force_prev, r0, e_relaxed, v_c1, v_c2
 ):
-    """`_advance_packed` (`journal`, `a` .. `dt`, `max_substep`, `force_prev` as there), the
-    edge limit given as ``max_edge_cells`` elements of this row, then the step's derived
-    outputs from the kernel's ``out`` slots, computed as `simulator._phase` and
-    `ContactSimulator.step` computed them in Python (the same IEEE operations in the same
-    order: the same bits). The simulator's one kernel call per step or force trial.
+    """`_advance_packed` on the row whose buffers are at addresses `state` and `const`
+    (`Row.addresses`; the caller holds the row for the whole call), `journal`, `a` .. `dt`,
+    `max_substep` and `force_prev` as there, the edge limit given as ``max_edge_cells``
+    elements of this row; then the step's derived outputs from the kernel's ``out`` slots,
+    computed as `simulator._phase` and `ContactSimulator.step` computed them in Python (the
+    same IEEE operations in the same order: the same bits). The simulator's one kernel call
+    per step or force trial. Addresses rather than arrays: numba unboxes an array argument
+    in about 0.14 us, an integer in a few ns.
 
     r0: the contact radius before the step (the last output's), m; e_relaxed: the relaxed
     modulus E_r*, Pa; v_c1, v_c2: the critical edge speeds (advancing, receding), m/s.
@@ -2735,10 +2747,10 @@ def _step_packed(
     ``out`` slots (``dissipated``: over this step), the phase code (``PHASE_*``), and, when
     status is not STATUS_OK, outputs of a partial step that the caller discards (it
     restores the memory from the journal)."""
-    args, txn, txn_b = _unpack(state, const)
+    args, txn, txn_b = _unpack_at(state, const)
     if journal:
         _copy_state(args[0], args[2], txn, txn_b)
-    dx = const[4]
+    dx = args[8]
     max_edge_move = max_edge_cells * dx
     if math.isnan(force_prev):
         status = _advance(*args, a, d0, d1, dt, max_substep, max_edge_move)
@@ -2759,7 +2771,7 @@ def _step_packed(
         elif radius < r0 - rest:
             phase = PHASE_DETACHING
         else:
-            tol = 1e-9 * (abs(d1) + const[7] * math.sqrt(radius) + g_edge)
+            tol = 1e-9 * (abs(d1) + args[16] * math.sqrt(radius) + g_edge)
             if outside >= -tol:
                 phase = PHASE_INDENTING
             elif inside <= tol:
@@ -2794,7 +2806,7 @@ def _step_packed(
 
 #: `_step_packed`'s argument types: its one compiled version, whose entry point
 #: (`step_entry`) the simulator calls directly.
-_STEP_SIGNATURE = (types.float64[::1], types.float64[::1], types.boolean) + (types.float64,) * 11
+_STEP_SIGNATURE = (types.intp, types.intp, types.boolean) + (types.float64,) * 11
 
 
 @functools.cache
@@ -2802,8 +2814,8 @@ def step_entry():
     """`_step_packed`'s compiled entry point for `_STEP_SIGNATURE`, called without numba's
     dispatcher: the dispatcher types every argument to pick the version (about 0.6 us per
     call with 13 arguments, measured side by side with `benchmarks/dispatch_options.py`);
-    the entry point only unboxes them. The caller must pass exactly these types (two
-    C-contiguous float64 arrays, a bool, then 11 floats): nothing checks them."""
+    the entry point only unboxes them. The caller must pass exactly these types (a row's
+    two `Row.addresses`, a bool, then 11 floats): nothing checks them."""
     return _step_packed.compile(_STEP_SIGNATURE)
 
 
@@ -2987,9 +2999,18 @@ class Row:
         row._kernel_args = None
         return row
 
-    def __getattr__(self, name: str) -> np.ndarray:
-        """An array view not bound yet (`regrid` binds them on first use): bind it now."""
+    def __getattr__(self, name: str) -> Any:
+        """An array view not bound yet (`regrid` binds them on first use): bind it now. Also
+        ``addresses``: the addresses of ``(_state, _const)`` (`_step_packed` takes them),
+        found on first use (``ndarray.ctypes`` costs about a microsecond) and kept; never
+        copied to another row (`with_memory`, pickling)."""
         fields = self.__dict__
+        if name == "addresses" and "_state" in fields:
+            addresses = fields["addresses"] = (
+                fields["_state"].ctypes.data,
+                fields["_const"].ctypes.data,
+            )
+            return addresses
         slots = fields.get("_slots")
         if slots is not None and name in slots:
             in_state, first, end, shape = slots[name]
@@ -3009,7 +3030,7 @@ class Row:
     def __getstate__(self) -> dict:
         # Pickling or deep-copying the views would cut them from their buffers: keep the
         # buffers and the scalars, rebind the views on load.
-        kept = {key: value for key, value in self.__dict__.items() if key not in _VIEW_NAMES}
+        kept = {key: value for key, value in self.__dict__.items() if key not in _NOT_PICKLED}
         kept["_kernel_args"] = None
         return kept
 
@@ -3075,6 +3096,7 @@ class Row:
         copy of the Kelvin state `wl`, `wb` (N, K; wb None: zeros)."""
         clone = object.__new__(Row)
         clone.__dict__.update(self.__dict__)
+        clone.__dict__.pop("addresses", None)  # its own state buffer
         clone._state = np.zeros_like(self._state)
         for name, view in _views(clone._state, 0, _state_layout(*self.wl.shape)):
             setattr(clone, name, view)
@@ -3287,8 +3309,8 @@ def warm_up() -> None:
     # The simulator's step calls the kernel through its two buffers (`_step_packed`'s entry
     # point; `_advance_packed`, the same without the derived outputs, is the benchmarks').
     step = step_entry()
-    step(row._state, row._const, True, 0.0, 0.0, 0.1, 0.01, 0.0, 1.0, math.nan, 0.0, 1.0, 1.0, 1.0)
-    step(row._state, row._const, False, 0.0, 0.0, 0.1, 0.01, 0.0, 1.0, 0.0, 0.0, 1.0, 1.0, 1.0)
+    step(*row.addresses, True, 0.0, 0.0, 0.1, 0.01, 0.0, 1.0, math.nan, 0.0, 1.0, 1.0, 1.0)
+    step(*row.addresses, False, 0.0, 0.0, 0.1, 0.01, 0.0, 1.0, 0.0, 0.0, 1.0, 1.0, 1.0)
     _restore_state(row.wl, row.wsum, row.wb, row.bsum, row.txn, row.txn_b)
     _g_at(0.3, row.gf, row.df)
     stored_energy(row, 0.3, 0.1)

@@ -658,9 +658,10 @@ class _TimeStepped:
             # The kernel itself, not the validating wrapper: the row's arrays are checked
             # when built, the step's scalars by ContactSimulator.step.
             # (`_step_packed`'s phase and speed outputs are not needed here: `_publish` makes them.)
+            state, const = row.addresses
             result = _STEP(
-                row._state,
-                row._const,
+                state,
+                const,
                 journal,
                 self.radius,
                 d0,
@@ -1193,6 +1194,7 @@ class ContactSimulator:
                     else:
                         force_prev = math.nan
                     dt = t - time0
+                    state, const = row.addresses
                     energy0 = self._energy_input
                     held0 = self._held_force
                     model._journal = None
@@ -1212,8 +1214,8 @@ class ContactSimulator:
                             effective,
                             separated,
                         ) = _STEP(
-                            row._state,
-                            row._const,
+                            state,
+                            const,
                             True,
                             radius0,
                             d_prev,
