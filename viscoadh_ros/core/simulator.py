@@ -1156,9 +1156,13 @@ class ContactSimulator:
         # this one frame, the edge outputs read from the kernel's (`edge_height` and
         # `edge_gaps` return the same values after an advance): the general path's outputs and
         # state bit for bit, and its transaction (tests/test_step_lean.py).
-        if force is None and self._lean and isinstance(depth, float) and isinstance(time, float):
-            t = time if type(time) is float else float(time)
-            d = depth if type(depth) is float else float(depth)
+        if force is None and self._lean:
+            if type(depth) is float and type(time) is float:
+                t, d = time, depth
+            elif isinstance(depth, float) and isinstance(time, float):
+                t, d = float(time), float(depth)
+            else:
+                return self._step_transaction(time, depth, force)
             model = self._model
             d_prev = self._depth
             output0 = self._output
