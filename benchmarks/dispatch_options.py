@@ -78,6 +78,12 @@ def _two_buffers_unpacked(state, const, journal, a, d0, d1, dt, ms, me):
     return args[0].shape[0] + txn.shape[0]
 
 
+@numba.njit(nogil=True)
+def _two_addresses(state, const, journal, a, d0, d1, dt, ms, mc, fp, r0, er, v1, v2):
+    # `_kernels._step_packed`'s signature and the shape of its result (a tuple of scalars).
+    return (0, a, d0, d1, 1, dt, ms, (mc, fp, r0), 1, er, v1 + v2, journal)
+
+
 def main() -> None:
     sim = ContactSimulator(SceneConfig.from_yaml(default_scene_path()).contacts[0])
     for i in range(1, 60):
@@ -95,6 +101,9 @@ def main() -> None:
 
         return run
 
+    addresses = row.addresses
+    entry = _two_addresses.compile(_kernels._STEP_SIGNATURE)
+    step_args = (*addresses, True, 1.0, 2.0, 3.0, 1e-3, 0.0, 1.0, 0.5, 1.0, 2.0, 3.0, 4.0)
     options = {
         "32 arguments (20 arrays, 12 floats): _advance's signature": loop(
             lambda: _args32(*args, 1.0, 2.0, 3.0, 1e-3, 0.0, 1e-6)
@@ -122,6 +131,10 @@ def main() -> None:
         "2 buffers + bool + 6 floats, views by _unpack (carray)": loop(
             lambda: _two_buffers_unpacked(state, const, True, 1.0, 2.0, 3.0, 1e-3, 0.0, 1e-6)
         ),
+        "2 addresses + bool + 11 floats, a 12-tuple returned (`_step_packed`), dispatcher": loop(
+            lambda: _two_addresses(*step_args)
+        ),
+        "the same through its entry point (`_kernels.step_entry`)": loop(lambda: entry(*step_args)),
         "empty Python loop (lambda call)": loop(lambda: None),
     }
     for run in options.values():

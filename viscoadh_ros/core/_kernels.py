@@ -2812,10 +2812,11 @@ _STEP_SIGNATURE = (types.intp, types.intp, types.boolean) + (types.float64,) * 1
 @functools.cache
 def step_entry():
     """`_step_packed`'s compiled entry point for `_STEP_SIGNATURE`, called without numba's
-    dispatcher: the dispatcher types every argument to pick the version (about 0.6 us per
-    call with 13 arguments, measured side by side with `benchmarks/dispatch_options.py`);
-    the entry point only unboxes them. The caller must pass exactly these types (a row's
-    two `Row.addresses`, a bool, then 11 floats): nothing checks them."""
+    dispatcher: the dispatcher types every argument to pick the version (about 0.3 us of a
+    0.6 us call with these 14 arguments, `benchmarks/dispatch_options.py`); the entry point
+    only unboxes them. The caller must pass exactly these types (a row's two
+    `Row.addresses`, a bool, then 11 floats): an array or None where a number belongs is a
+    TypeError, but no address is checked."""
     return _step_packed.compile(_STEP_SIGNATURE)
 
 
