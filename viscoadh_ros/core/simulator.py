@@ -1175,11 +1175,13 @@ class ContactSimulator:
                 and not (d < 0.0 and d_prev < 0.0 and r0 <= 0.0 and model.is_relaxed())
             ):
                 row = model.row
-                if row is not None:
+                if row is not None and "advance" not in model.__dict__:
                     # The row exists (the common case): `begin`, `advance`, `_phase` and the
                     # derived outputs in one compiled call (`_STEP`, journal included), the
                     # transaction's token kept in locals. A step that needs a larger domain
-                    # goes back to the journal and takes the path below (it grows the row).
+                    # goes back to the journal and takes the path below (it grows the row),
+                    # as does a model whose `advance` was replaced on the instance (the fault
+                    # tests inject errors after the kernel that way).
                     radius0 = model.radius
                     dissipated0 = model.dissipated
                     peak0 = model._memory_peak
