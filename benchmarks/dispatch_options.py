@@ -22,7 +22,7 @@ CALLS = 2000
 
 
 @numba.njit(nogil=True)
-def _args31(wl, wsum, wb, bsum, scratch, scratch_b, diss, dx, g_c, gf, gint, gmin, gmax, df, e0, c_crit,
+def _args32(wl, wsum, wb, bsum, scratch, scratch_b, diss, coef, dx, g_c, gf, gint, gmin, gmax, df, e0, c_crit,
             reach, p, p_inv, lam, beta, rate, kap, e_kelvin, out, a, d0, d1, dt, ms, me):  # fmt: skip
     out[0] = a + wl.shape[0]
     return 0
@@ -35,7 +35,7 @@ def _tuple(args, a, d0, d1, dt, ms, me):
 
 
 @numba.njit(nogil=True)
-def _arrays_and_scalar_array(wl, wsum, wb, bsum, scratch, scratch_b, diss, g_c, gf, gint, gmin, gmax, p,
+def _arrays_and_scalar_array(wl, wsum, wb, bsum, scratch, scratch_b, diss, coef, g_c, gf, gint, gmin, gmax, p,
                              p_inv, lam, beta, rate, e_kelvin, out, scalars):  # fmt: skip
     out[0] = scalars[0]
     return 0
@@ -78,6 +78,12 @@ def _two_buffers_unpacked(state, const, journal, a, d0, d1, dt, ms, me):
     return args[0].shape[0] + txn.shape[0]
 
 
+@numba.njit(nogil=True)
+def _two_addresses(state, const, journal, a, d0, d1, dt, ms, mc, fp, r0, er, v1, v2):
+    # `_kernels._step_packed`'s signature and the shape of its result (a tuple of scalars).
+    return (0, a, d0, d1, 1, dt, ms, (mc, fp, r0), 1, er, v1 + v2, journal)
+
+
 def main() -> None:
     sim = ContactSimulator(SceneConfig.from_yaml(default_scene_path()).contacts[0])
     for i in range(1, 60):
@@ -95,14 +101,17 @@ def main() -> None:
 
         return run
 
+    addresses = row.addresses
+    entry = _two_addresses.compile(_kernels._STEP_SIGNATURE)
+    step_args = (*addresses, True, 1.0, 2.0, 3.0, 1e-3, 0.0, 1.0, 0.5, 1.0, 2.0, 3.0, 4.0)
     options = {
-        "31 arguments (19 arrays, 12 floats): _advance's signature": loop(
-            lambda: _args31(*args, 1.0, 2.0, 3.0, 1e-3, 0.0, 1e-6)
+        "32 arguments (20 arrays, 12 floats): _advance's signature": loop(
+            lambda: _args32(*args, 1.0, 2.0, 3.0, 1e-3, 0.0, 1e-6)
         ),
-        "the row's 25 arguments as one tuple + 6 floats": loop(
+        "the row's 26 arguments as one tuple + 6 floats": loop(
             lambda: _tuple(args, 1.0, 2.0, 3.0, 1e-3, 0.0, 1e-6)
         ),
-        "19 arrays + the scalars packed in one array": loop(
+        "20 arrays + the scalars packed in one array": loop(
             lambda: _arrays_and_scalar_array(*arrays, scalars)
         ),
         "2 buffers + the scalars packed in one array (3 writes)": loop(
@@ -122,6 +131,10 @@ def main() -> None:
         "2 buffers + bool + 6 floats, views by _unpack (carray)": loop(
             lambda: _two_buffers_unpacked(state, const, True, 1.0, 2.0, 3.0, 1e-3, 0.0, 1e-6)
         ),
+        "2 addresses + bool + 11 floats, a 12-tuple returned (`_step_packed`), dispatcher": loop(
+            lambda: _two_addresses(*step_args)
+        ),
+        "the same through its entry point (`_kernels.step_entry`)": loop(lambda: entry(*step_args)),
         "empty Python loop (lambda call)": loop(lambda: None),
     }
     for run in options.values():

@@ -147,9 +147,10 @@ def test_an_interrupt_inside_the_lean_step_changes_nothing(monkeypatch: pytest.M
 
 @pytest.mark.parametrize("kelvin", [0, 1, 3])
 def test_the_packed_views_are_the_rows_kernel_arguments(kelvin: int) -> None:
-    """`_kernels._unpack` (what `_advance_packed` hands `_advance`) finds every array of
-    `Row.kernel_args` at the same address with the same shape, and the same scalars; also
-    for a `with_memory` clone and after pickling and deep copying."""
+    """`_kernels._unpack` (what `_advance_packed` hands `_advance`; `_step_packed` makes the
+    same views from `Row.addresses`) finds every array of `Row.kernel_args` at the same
+    address with the same shape, and the same scalars; also for a `with_memory` clone and
+    after pickling and deep copying."""
     contact = one_contact(
         {"shape": "sphere", "radius": 0.005},
         kelvin=[1e5 * (k + 1) for k in range(kelvin)],
@@ -161,8 +162,11 @@ def test_the_packed_views_are_the_rows_kernel_arguments(kelvin: int) -> None:
     for k in range(1, 20):
         sim.step(k * 1e-3, depth=k * 1e-6)
     row = sim._model.row
+    assert row.addresses  # found (and kept) before the copies below are made
     clone = row.with_memory(row.wl * 0.5, row.wb)
     for candidate in (row, clone, pickle.loads(pickle.dumps(row)), copy.deepcopy(row)):
+        # `Row.addresses` (what `_step_packed` takes) are the row's own buffers, never a copy's.
+        assert candidate.addresses == (candidate._state.ctypes.data, candidate._const.ctypes.data)
         args, txn, txn_b = _kernels._unpack(candidate._state, candidate._const)
         expected = candidate.kernel_args
         assert len(args) == len(expected) == _kernels._advance.py_func.__code__.co_argcount - 6
@@ -178,3 +182,115 @@ def test_the_packed_views_are_the_rows_kernel_arguments(kelvin: int) -> None:
             assert txn_b.ctypes.data == candidate.txn_b.ctypes.data
     assert np.array_equal(clone.wl, row.wl * 0.5) and not np.shares_memory(clone.wl, row.wl)
     assert np.shares_memory(clone.gf, row.gf)
+
+
+def _bits(output) -> tuple:
+    """An output's fields as bits (phase and flags by value)."""
+    return tuple(np.array([float(getattr(output, name)) for name in STEP_OUTPUT_FIELDS]).view(np.uint64))
+
+
+def _kelvin4():
+    return one_contact(
+        {"shape": "sphere", "radius": 0.006},
+        kelvin=[3e5, 1e5, 2e5, 5e4],
+        viscosities=[3e2, 4e3, 2e4, 3e5],
+        work=0.06,
+        numerics={"elements": 80},
+    )
+
+
+def _reference_sequence(seed: int, scale: float) -> list[tuple[str, float, float]]:
+    """Depth steps with everything else between them: force steps, holds, jumps at one time,
+    refused calls (NaN, time going back, a depth the domain cannot represent, an interrupt
+    after the kernel ran), reset, snapshots restored later."""
+    rng = np.random.default_rng(seed)
+    kinds = ["depth"] * 14 + ["same_time", "force", "advance", "nan", "back", "huge", "interrupt"]
+    kinds += ["snapshot", "restore", "reset", "above"]
+    calls, t = [], 0.0
+    for _ in range(240):
+        kind = str(rng.choice(kinds))
+        t += 0.0 if kind == "same_time" else float(rng.choice([1e-3, 1e-4, 5e-3]))
+        calls.append((kind, t, scale * float(rng.uniform(-0.6, 1.6))))
+    return calls
+
+
+@pytest.mark.parametrize(
+    "name", ["elastic_stepped", "default", "standard_fast", "two_kelvin", "growing", "punch", "kelvin4"]
+)
+@pytest.mark.parametrize("seed", [3, 4])
+def test_the_one_call_step_equals_the_0_4_0_step(
+    name: str, seed: int, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """`step` (one compiled call per depth step, `_kernels._step_packed`) against the 0.4.0 step
+    path kept in tests/step_reference.py on the same kernels, K = 0, 1, 2 and 4: bit-equal
+    outputs, the same refusals, and bit-equal states (memory included) after every call, over
+    random sequences with force steps, holds, domain growth, out-of-contact steps with
+    memory, refused calls mid-way (an interrupt after the kernel ran among them), reset and
+    snapshots restored later."""
+    from step_reference import reference_simulator, reference_step
+
+    if name == "kelvin4":
+        contact, scale = _kelvin4(), 3e-5
+    else:
+        contact, scale = scenes()[name], depth_scale(name)
+    new, old = ContactSimulator(contact), reference_simulator(contact)
+    saved: dict[int, object] = {}
+    real = simulator._object_new
+
+    def interrupted(*args):
+        raise _Interrupt
+
+    for kind, t, value in _reference_sequence(seed, scale):
+        results = []
+        for label, sim in (("new", new), ("old", old)):
+
+            def depth_step(t: float, d: float, sim=sim, label=label):
+                return sim.step(t, depth=d) if label == "new" else reference_step(sim, t, d)
+
+            try:
+                if kind in ("depth", "same_time"):
+                    results.append(_bits(depth_step(t, value)))
+                elif kind == "above":
+                    results.append(_bits(depth_step(t, -abs(value) - scale)))
+                elif kind == "force":
+                    results.append(_bits(sim.step(t, force=value * 1e2)))
+                elif kind == "advance":
+                    if sim._held_force is not None:
+                        results.append(_bits(sim.step(t, force=sim._held_force)))
+                    else:
+                        results.append(_bits(depth_step(t, sim._depth)))
+                elif kind == "nan":
+                    results.append(_bits(depth_step(t, math.nan)))
+                elif kind == "back":
+                    results.append(_bits(depth_step(t - 1.0, value)))
+                elif kind == "huge":
+                    results.append(_bits(depth_step(t, 1e3)))
+                elif kind == "interrupt":
+                    monkeypatch.setattr(simulator, "_object_new", interrupted)
+                    try:
+                        depth_step(t, value)
+                    except _Interrupt:
+                        results.append("interrupted")
+                    finally:
+                        monkeypatch.setattr(simulator, "_object_new", real)
+                elif kind == "snapshot":
+                    saved[id(sim)] = sim.snapshot()
+                    results.append("saved")
+                elif kind == "restore":
+                    if id(sim) in saved:
+                        sim.restore(saved[id(sim)])
+                    results.append("restored")
+                else:
+                    sim.reset(t)
+                    results.append("reset")
+            except ValueError as error:
+                results.append(type(error).__name__ + str(error))
+        assert results[0] == results[1], (kind, t, value)
+        state_new, state_old = _state(new), _state(old)
+        assert state_new[:2] == state_old[:2] and _bits(state_new[2]) == _bits(state_old[2])
+        assert state_new[3:11] == state_old[3:11], (kind, t, value)
+        assert state_new[12] == state_old[12], (kind, t, value)
+        assert (state_new[11] is None) == (state_old[11] is None)
+        if state_new[11] is not None:
+            assert state_new[11].elements == state_old[11].elements
+            assert state_new[11].dx == state_old[11].dx

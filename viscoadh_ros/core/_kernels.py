@@ -46,6 +46,7 @@ from __future__ import annotations
 
 import functools
 import math
+from typing import Any
 
 import numba
 import numpy as np
@@ -2530,6 +2531,8 @@ def _const_layout(n: int, k: int, m: int, blocks: int) -> tuple[tuple[str, tuple
 
 
 _VIEW_NAMES = frozenset(name for name, _ in _state_layout(1, 1) + _const_layout(1, 1, 2, 1))
+#: What a pickled (or deep-copied) row leaves behind: the views and the buffers' addresses.
+_NOT_PICKLED = _VIEW_NAMES | {"addresses"}
 
 
 def _arena_size(layout: tuple[tuple[str, tuple[int, ...]], ...], start: int) -> int:
@@ -2599,13 +2602,19 @@ def _unpack(state, const):
     """The row's kernel arguments (as `Row.kernel_args`) and its journal (txn, txn_b) as
     views of its two buffers (`_state_layout`, `_const_layout`, the header). The views do not
     keep the buffers alive: use them only inside the call that received the buffers."""
+    return _unpack_at(state.ctypes.data, const.ctypes.data)
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _unpack_at(s, c):
+    """`_unpack` of the buffers at addresses `s` (`Row._state`) and `c` (`Row._const`)
+    (`Row.addresses`): the caller holds the buffers for the whole call."""
+    const = _view(c, 0, PACK_HEADER)
     n = int(const[0])
     k = int(const[1])
     m = int(const[2])
     blocks = int(const[3])
     nk = n * k
-    s = state.ctypes.data
-    c = const.ctypes.data
     o = 0
     wl = _view(s, o, (n, k))
     o += nk
@@ -2708,6 +2717,107 @@ def _advance_packed(state, const, journal, a, d0, d1, dt, max_substep, max_edge_
     if math.isnan(force_prev):
         return _advance(*args, a, d0, d1, dt, max_substep, max_edge_move)
     return _advance_from(*args, a, d0, d1, dt, max_substep, max_edge_move, force_prev)
+
+
+#: Phase codes `_step_packed` returns (the values of `simulator.Phase`).
+PHASE_NO_CONTACT, PHASE_INDENTING, PHASE_STICKING, PHASE_DETACHING = 0, 1, 2, 3
+
+
+# With the runtime, like `_advance_packed` (the views `_unpack` makes carry no reference
+# count). Its return value is a tuple of scalars: boxing it costs less than reading the same
+# values back from ``out`` in Python.
+@numba.njit(cache=True, nogil=True)
+def _step_packed(
+    state, const, journal, a, d0, d1, dt, max_substep, max_edge_cells, force_prev, r0, e_relaxed, v_c1, v_c2
+):
+    """`_advance_packed` on the row whose buffers are at addresses `state` and `const`
+    (`Row.addresses`; the caller holds the row for the whole call), `journal`, `a` .. `dt`,
+    `max_substep` and `force_prev` as there, the edge limit given as ``max_edge_cells``
+    elements of this row; then the step's derived outputs from the kernel's ``out`` slots,
+    computed as `simulator._phase` and `ContactSimulator.step` computed them in Python (the
+    same IEEE operations in the same order: the same bits). The simulator's one kernel call
+    per step or force trial. Addresses rather than arrays: numba unboxes an array argument
+    in about 0.14 us, an integer in a few ns.
+
+    r0: the contact radius before the step (the last output's), m; e_relaxed: the relaxed
+    modulus E_r*, Pa; v_c1, v_c2: the critical edge speeds (advancing, receding), m/s.
+
+    Returns ``(status, radius, force, work, substeps, dissipated, memory_peak, (gap_outside,
+    gap_inside, g_edge), phase, edge_speed, effective_work, scale_separation_ok)``: the
+    ``out`` slots (``dissipated``: over this step), the phase code (``PHASE_*``), and, when
+    status is not STATUS_OK, outputs of a partial step that the caller discards (it
+    restores the memory from the journal)."""
+    args, txn, txn_b = _unpack_at(state, const)
+    if journal:
+        _copy_state(args[0], args[2], txn, txn_b)
+    dx = args[8]
+    max_edge_move = max_edge_cells * dx
+    if math.isnan(force_prev):
+        status = _advance(*args, a, d0, d1, dt, max_substep, max_edge_move)
+    else:
+        status = _advance_from(*args, a, d0, d1, dt, max_substep, max_edge_move, force_prev)
+    out = args[25]
+    radius = out[OUT_RADIUS]
+    outside = out[OUT_GAP_OUTSIDE]
+    inside = out[OUT_GAP_INSIDE]
+    g_edge = out[OUT_G_EDGE] if radius > 0.0 else 0.0
+    # `simulator._phase`: an edge that moved less than twice its location tolerance is at rest.
+    if radius <= 0.0:
+        phase = PHASE_NO_CONTACT
+    else:
+        rest = 2.0 * EDGE_TOLERANCE * dx
+        if radius > r0 + rest:
+            phase = PHASE_INDENTING
+        elif radius < r0 - rest:
+            phase = PHASE_DETACHING
+        else:
+            tol = 1e-9 * (abs(d1) + args[16] * math.sqrt(radius) + g_edge)
+            if outside >= -tol:
+                phase = PHASE_INDENTING
+            elif inside <= tol:
+                phase = PHASE_DETACHING
+            else:
+                phase = PHASE_STICKING
+    edge_speed = (radius - r0) / dt if dt > 0.0 else 0.0
+    u = d1 - g_edge
+    if radius > 0.0 and u < 0.0:
+        effective = e_relaxed * u * u / (2.0 * math.pi * radius)
+    else:
+        effective = 0.0
+    if edge_speed == 0.0:
+        separated = True
+    else:
+        separated = abs(edge_speed) >= (v_c1 if edge_speed > 0.0 else v_c2)
+    return (
+        status,
+        radius,
+        out[OUT_FORCE],
+        out[OUT_WORK],
+        int(out[OUT_SUBSTEPS]),
+        out[OUT_DISSIPATED],
+        out[OUT_MEMORY],
+        (outside, inside, out[OUT_G_EDGE]),
+        phase,
+        edge_speed,
+        effective,
+        separated,
+    )
+
+
+#: `_step_packed`'s argument types: its one compiled version, whose entry point
+#: (`step_entry`) the simulator calls directly.
+_STEP_SIGNATURE = (types.intp, types.intp, types.boolean) + (types.float64,) * 11
+
+
+@functools.cache
+def step_entry():
+    """`_step_packed`'s compiled entry point for `_STEP_SIGNATURE`, called without numba's
+    dispatcher: the dispatcher types every argument to pick the version (about 0.3 us of a
+    0.6 us call with these 14 arguments, `benchmarks/dispatch_options.py`); the entry point
+    only unboxes them. The caller must pass exactly these types (a row's two
+    `Row.addresses`, a bool, then 11 floats): an array or None where a number belongs is a
+    TypeError, but no address is checked."""
+    return _step_packed.compile(_STEP_SIGNATURE)
 
 
 class Row:
@@ -2890,9 +3000,18 @@ class Row:
         row._kernel_args = None
         return row
 
-    def __getattr__(self, name: str) -> np.ndarray:
-        """An array view not bound yet (`regrid` binds them on first use): bind it now."""
+    def __getattr__(self, name: str) -> Any:
+        """An array view not bound yet (`regrid` binds them on first use): bind it now. Also
+        ``addresses``: the addresses of ``(_state, _const)`` (`_step_packed` takes them),
+        found on first use (``ndarray.ctypes`` costs about a microsecond) and kept; never
+        copied to another row (`with_memory`, pickling)."""
         fields = self.__dict__
+        if name == "addresses" and "_state" in fields:
+            addresses = fields["addresses"] = (
+                fields["_state"].ctypes.data,
+                fields["_const"].ctypes.data,
+            )
+            return addresses
         slots = fields.get("_slots")
         if slots is not None and name in slots:
             in_state, first, end, shape = slots[name]
@@ -2912,7 +3031,7 @@ class Row:
     def __getstate__(self) -> dict:
         # Pickling or deep-copying the views would cut them from their buffers: keep the
         # buffers and the scalars, rebind the views on load.
-        kept = {key: value for key, value in self.__dict__.items() if key not in _VIEW_NAMES}
+        kept = {key: value for key, value in self.__dict__.items() if key not in _NOT_PICKLED}
         kept["_kernel_args"] = None
         return kept
 
@@ -2978,6 +3097,7 @@ class Row:
         copy of the Kelvin state `wl`, `wb` (N, K; wb None: zeros)."""
         clone = object.__new__(Row)
         clone.__dict__.update(self.__dict__)
+        clone.__dict__.pop("addresses", None)  # its own state buffer
         clone._state = np.zeros_like(self._state)
         for name, view in _views(clone._state, 0, _state_layout(*self.wl.shape)):
             setattr(clone, name, view)
@@ -3187,9 +3307,11 @@ def warm_up() -> None:
     # The simulator's transaction journal and force-search restores call these from Python.
     _copy_state(row.wl, row.wb, row.txn, row.txn_b)
     _restore_state(row.wl, row.wsum, row.wb, row.bsum, row.txn, row.txn_b)
-    # The simulator's step calls the kernel through its two buffers.
-    _advance_packed(row._state, row._const, True, 0.0, 0.0, 0.1, 0.01, 0.0, 0.25, math.nan)
-    _advance_packed(row._state, row._const, False, 0.0, 0.0, 0.1, 0.01, 0.0, 0.25, 0.0)
+    # The simulator's step calls the kernel through its two buffers (`_step_packed`'s entry
+    # point; `_advance_packed`, the same without the derived outputs, is the benchmarks').
+    step = step_entry()
+    step(*row.addresses, True, 0.0, 0.0, 0.1, 0.01, 0.0, 1.0, math.nan, 0.0, 1.0, 1.0, 1.0)
+    step(*row.addresses, False, 0.0, 0.0, 0.1, 0.01, 0.0, 1.0, 0.0, 0.0, 1.0, 1.0, 1.0)
     _restore_state(row.wl, row.wsum, row.wb, row.bsum, row.txn, row.txn_b)
     _g_at(0.3, row.gf, row.df)
     stored_energy(row, 0.3, 0.1)

@@ -93,6 +93,9 @@ STEP_OUTPUT_FIELDS = tuple(f.name for f in fields(StepOutput))
 
 _object_new = object.__new__
 
+#: `_kernels.step_entry()`, bound when the first time-stepped model is built.
+_STEP: Any = None
+
 
 def _new_output(
     time: float,
@@ -136,6 +139,8 @@ _NO_CONTACT = Phase.NO_CONTACT
 _INDENTING = Phase.INDENTING
 _STICKING = Phase.STICKING
 _DETACHING = Phase.DETACHING
+#: By their values (`_kernels.PHASE_*`).
+_PHASES = (_NO_CONTACT, _INDENTING, _STICKING, _DETACHING)
 
 
 #: Largest flank slope f'(a) at the contact edge for which the half-space (small-slope) theory
@@ -398,8 +403,13 @@ class _TimeStepped:
         self.physics = physics
         self.numerics = numerics
         # Read every kernel call (the numerics are frozen).
-        self._max_substep = numerics.max_substep
-        self._max_edge_cells = numerics.max_edge_cells
+        self._max_substep = float(numerics.max_substep)
+        self._max_edge_cells = float(numerics.max_edge_cells)
+        # The compiled step (`_kernels._step_packed`) called through its entry point; loaded
+        # (or compiled) with the first time-stepped model.
+        global _STEP
+        if _STEP is None:
+            _STEP = _kernels.step_entry()
         creep = physics.creep
         e_kelvin = np.array([creep.modulus_star(g) for g in creep.kelvin_shear_moduli], dtype=np.float64)
         # Dampers scale like springs: eta* = 2 eta / (1 - nu).
@@ -734,20 +744,26 @@ class _TimeStepped:
                 self._journal = row
             # The kernel itself, not the validating wrapper: the row's arrays are checked
             # when built, the step's scalars by ContactSimulator.step.
-            status = _kernels._advance_packed(
-                row._state,
-                row._const,
+            # (`_step_packed`'s phase and speed outputs are not needed here: `_publish` makes them.)
+            state, const = row.addresses
+            result = _STEP(
+                state,
+                const,
                 journal,
                 self.radius,
                 d0,
                 d1,
                 dt,
                 self._max_substep,
-                self._max_edge_cells * row.dx,
+                self._max_edge_cells,
                 force_prev,
+                self.radius,
+                0.0,
+                0.0,
+                0.0,
             )
             journal = False
-            if status == _kernels.STATUS_OK:
+            if result[0] == _kernels.STATUS_OK:
                 break
             force_prev = math.nan  # a new row after the growth
             if start is None:
@@ -757,12 +773,12 @@ class _TimeStepped:
             self.radius, self.dissipated = radius0, dissipated0
             self._grow(d0)
             start = self.get_state()
-        radius, force, work, _, substeps, dissipated, peak, outside, inside, g_edge = row.out.tolist()
+        _, radius, force, work, substeps, dissipated, peak, edge = result[:8]
         self.radius = radius
-        self.substeps = int(substeps)
+        self.substeps = substeps
         self.dissipated += dissipated
         self._memory_peak = peak
-        self._edge = (outside, inside, g_edge)
+        self._edge = edge
         self._edge_depth = d1
         self._force_at = (row, radius, d1, force)
         if row is not self._prepare_row:
@@ -1015,6 +1031,10 @@ class _TimeStepped:
         self._force_at = None
 
 
+#: The code of `_TimeStepped.advance`, which `ContactSimulator.step`'s one-call path inlines.
+_ADVANCE_CODE = _TimeStepped.advance.__code__
+
+
 def _phase(model: Any, physics: _Physics, depth: float, r0: float, radius: float, g_edge: float) -> Phase:
     """The phase of a step that moved the edge from `r0` to `radius` (m) at `depth` (m), g at
     the new edge `g_edge` (m). The one rule for `step`'s lean and general paths
@@ -1216,6 +1236,9 @@ class ContactSimulator:
             self._model = _TimeStepped(self.physics, self.numerics)
         # Depth steps may take the lean path in `step` (the time-stepped model only).
         self._lean = isinstance(self._model, _TimeStepped)
+        # The physics constants the compiled step derives its outputs from (`_STEP`).
+        self._e_relaxed = float(self.physics.e_relaxed)
+        self._v_c1, self._v_c2 = (float(v) for v in self.physics.critical_speeds)
         self.reset(0.0)
 
     # -- public state ---------------------------------------------------------------------
@@ -1335,9 +1358,13 @@ class ContactSimulator:
         # this one frame, the edge outputs read from the kernel's (`edge_height` and
         # `edge_gaps` return the same values after an advance): the general path's outputs and
         # state bit for bit, and its transaction (tests/test_step_lean.py).
-        if force is None and self._lean and isinstance(depth, float) and isinstance(time, float):
-            t = time if type(time) is float else float(time)
-            d = depth if type(depth) is float else float(depth)
+        if force is None and self._lean:
+            if type(depth) is float and type(time) is float:
+                t, d = time, depth
+            elif isinstance(depth, float) and isinstance(time, float):
+                t, d = float(time), float(depth)
+            else:
+                return self._step_transaction(time, depth, force)
             model = self._model
             d_prev = self._depth
             output0 = self._output
@@ -1349,6 +1376,119 @@ class ContactSimulator:
                 and t >= time0
                 and not (d < 0.0 and d_prev < 0.0 and r0 <= 0.0 and model.is_relaxed())
             ):
+                row = model.row
+                if row is not None and getattr(model.advance, "__code__", None) is _ADVANCE_CODE:
+                    # The row exists (the common case): `begin`, `advance`, `_phase` and the
+                    # derived outputs in one compiled call (`_STEP`, journal included), the
+                    # transaction's token kept in locals. A step that needs a larger domain
+                    # goes back to the journal and takes the path below (it grows the row),
+                    # as does a model whose `advance` was replaced on the instance (the fault
+                    # tests inject errors after the kernel that way; reading the instance's
+                    # `__dict__` instead cost ~0.4 us a step: it deoptimises the model's
+                    # attribute access).
+                    radius0 = model.radius
+                    dissipated0 = model.dissipated
+                    peak0 = model._memory_peak
+                    edge0 = model._edge
+                    edge_depth0 = model._edge_depth
+                    known = model._force_at
+                    # `_TimeStepped.advance`'s rule for the force known at the start.
+                    if (
+                        known is not None
+                        and known[0] is row
+                        and known[1] == radius0
+                        and known[2] == d_prev
+                        and d_prev != 0.0
+                    ):
+                        force_prev = known[3]
+                    else:
+                        force_prev = math.nan
+                    dt = t - time0
+                    state, const = row.addresses
+                    energy0 = self._energy_input
+                    held0 = self._held_force
+                    model._journal = None
+                    try:
+                        model._journal = row
+                        (
+                            status,
+                            radius,
+                            f,
+                            work,
+                            substeps,
+                            step_dissipated,
+                            peak,
+                            edge,
+                            phase,
+                            edge_speed,
+                            effective,
+                            separated,
+                        ) = _STEP(
+                            state,
+                            const,
+                            True,
+                            radius0,
+                            d_prev,
+                            d,
+                            dt,
+                            model._max_substep,
+                            model._max_edge_cells,
+                            force_prev,
+                            r0,
+                            self._e_relaxed,
+                            self._v_c1,
+                            self._v_c2,
+                        )
+                        if status == 0:  # _kernels.STATUS_OK
+                            energy = energy0 + work
+                            dissipated = dissipated0 + step_dissipated
+                            # The output first (nothing changed yet if it fails), then the
+                            # commit. Filling the instance's dict item by item is cheaper than
+                            # a dict display (`_new_output`).
+                            output = _object_new(StepOutput)
+                            values = output.__dict__
+                            values["time"] = t
+                            values["depth"] = d
+                            values["force"] = f
+                            values["contact_radius"] = radius
+                            values["phase"] = _PHASES[phase]
+                            values["edge_speed"] = edge_speed
+                            values["effective_work_of_adhesion"] = effective
+                            values["energy_input"] = energy
+                            values["energy_dissipated"] = dissipated
+                            values["scale_separation_ok"] = separated
+                            values["unstable"] = False
+                            model.radius = radius
+                            model.substeps = substeps
+                            model.dissipated = dissipated
+                            model._memory_peak = peak
+                            model._edge = edge
+                            model._edge_depth = d
+                            model._force_at = (row, radius, d, f)
+                            if row is not model._prepare_row:
+                                model._prepare_row = row
+                                model._prepare_radius = PREPARE_FRACTION * row.length
+                            if radius > model._prepare_radius:
+                                model._prepare_growth(row)
+                            self._energy_input = energy
+                            self._time = t
+                            self._depth = d
+                            self._output = output
+                            self._held_force = None
+                            return output
+                        _kernels._restore_state(row.wl, row.wsum, row.wb, row.bsum, row.txn, row.txn_b)
+                        model._journal = None
+                    except BaseException:
+                        # `model.rollback` of the token in the locals, and this simulator's fields.
+                        if model._journal is not None:
+                            _kernels._restore_state(row.wl, row.wsum, row.wb, row.bsum, row.txn, row.txn_b)
+                            model._journal = None
+                        model.radius, model.row, model.dissipated = radius0, row, dissipated0
+                        model._memory_peak, model._edge, model._edge_depth = peak0, edge0, edge_depth0
+                        model._force_at = known
+                        self._energy_input, self._time, self._depth = energy0, time0, d_prev
+                        self._output, self._held_force = output0, held0
+                        raise
                 energy0 = self._energy_input
                 held0 = self._held_force
                 token = model.begin()
