@@ -113,9 +113,7 @@ def replay_scene(modules: dict, repeats: int):
     runs["minimal"] = run_minimal
     run_minimal()
     columns = {
-        name: np.column_stack(
-            [np.asarray(value, dtype=np.float64) for key, value in sorted(res.items())]
-        )
+        name: np.column_stack([np.asarray(value, dtype=np.float64) for key, value in sorted(res.items())])
         for name, res in results.items()
     }
     keys = sorted(next(iter(results.values())).keys())
@@ -161,7 +159,16 @@ def _rows_scene(sim: ContactSimulator, times, depths, modules: dict):
         run()
     row.set_memory(wl0, wb0)
     keys = [
-        "radius", "force", "work", "motion", "substeps", "dissipated", "memory", "gap_out", "gap_in", "g_edge"
+        "radius",
+        "force",
+        "work",
+        "motion",
+        "substeps",
+        "dissipated",
+        "memory",
+        "gap_out",
+        "gap_in",
+        "g_edge",
     ]
     pull_off = abs(float(np.min(outs[next(iter(outs))][:, 1])))
     in_contact = float(np.mean(outs[next(iter(outs))][:, 0] > 0.0))
@@ -254,8 +261,13 @@ def main() -> None:
         ratios = [f"{first}/{name} {us[first] / us[name]:.3f}" for name in list(modules)[1:]]
         to_min = [f"{name}/min {us[name] / us['minimal']:.2f}" for name in modules]
         print(
-            f"{label}: us/row " + ", ".join(cells) + f", minimal {us['minimal']:.3f} | "
-            + ", ".join(ratios) + " | " + ", ".join(to_min) + f" | {note}",
+            f"{label}: us/row "
+            + ", ".join(cells)
+            + f", minimal {us['minimal']:.3f} | "
+            + ", ".join(ratios)
+            + " | "
+            + ", ".join(to_min)
+            + f" | {note}",
             flush=True,
         )
 
