@@ -742,6 +742,18 @@ def _chain_in_contact(
     ``dz/dt = zeta0 E(t) + beta slope F(t)``: a sum of non-negative terms (each term is the
     integral of a square; rounding below zero is cut)."""
     k_count = wl.shape[1]
+    return _chain_in_contact_k(
+        wl, wsum, wb, bsum, i, u0, u1, slope, p, p_inv, lam, beta, e, phi1, chi, cee, cef, cff, z, zb, k_count
+    )
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
+def _chain_in_contact_k(
+    wl, wsum, wb, bsum, i, u0, u1, slope, p, p_inv, lam, beta, e, phi1, chi, cee, cef, cff, z, zb, k_count
+):
+    """`_chain_in_contact` with the Kelvin count ``k_count`` (= wl.shape[1]) given: called with a
+    literal K (`_update_range`) the mode loops have a known length and are unrolled (0.5.0).
+    The same operations in the same order either way (the same bits)."""
     work = 0.0
     for m in range(k_count):
         acc = 0.0
@@ -777,10 +789,16 @@ def _chain_in_contact(
 def _chain_free(wl, wsum, wb, bsum, i, decay, e_kelvin):
     """Element i out of contact: each Kelvin element creeps back by its factor `decay`.
     Returns the Kelvin energy per unit width its dampers took, ``sum_k E_k (l^2 - l'^2)``."""
+    return _chain_free_k(wl, wsum, wb, bsum, i, decay, e_kelvin, wl.shape[1])
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
+def _chain_free_k(wl, wsum, wb, bsum, i, decay, e_kelvin, k_count):
+    """`_chain_free` with the Kelvin count given (see `_chain_in_contact_k`)."""
     total = 0.0
     total_b = 0.0
     lost = 0.0
-    for k in range(wl.shape[1]):
+    for k in range(k_count):
         before = wl[i, k]
         wl[i, k] = before * decay[k]
         wb[i, k] *= decay[k]
@@ -973,30 +991,48 @@ def _update_range(
     `_substep_coefficients`); returns ``(total, peak)``: ``total`` plus the energy they
     dissipated, J (K >= 2: added element by element in index order; K = 1: in four lanes,
     `_sum_losses`), and the larger of ``peak`` and their largest |wsum|, m."""
-    if wl.shape[1] == 1:
-        return _update_range_one(
-            wl,
-            wsum,
-            wb,
-            bsum,
-            diss,
-            lo,
-            hi,
-            n_in,
-            d0,
-            d1,
-            slope,
-            g_c,
-            p,
-            p_inv,
-            lam,
-            beta,
-            coef,
-            e_kelvin,
-            dx,
-            total,
-            peak,
-        )
+    k_count = wl.shape[1]
+    args = (wl, wsum, wb, bsum, diss, lo, hi, n_in, d0, d1, slope, g_c, p, p_inv, lam, beta, coef)
+    args = (*args, e_kelvin, dx)
+    if k_count == 1:
+        return _update_range_one(*args, total, peak)
+    # A literal K unrolls the mode loops (0.5.0: K = 4 ... per element; the same bits).
+    if k_count == 2:
+        return _update_range_k(*args, total, peak, 2)
+    if k_count == 3:
+        return _update_range_k(*args, total, peak, 3)
+    if k_count == 4:
+        return _update_range_k(*args, total, peak, 4)
+    return _update_range_k(*args, total, peak, k_count)
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _update_range_k(
+    wl,
+    wsum,
+    wb,
+    bsum,
+    diss,
+    lo,
+    hi,
+    n_in,
+    d0,
+    d1,
+    slope,
+    g_c,
+    p,
+    p_inv,
+    lam,
+    beta,
+    coef,
+    e_kelvin,
+    dx,
+    total,
+    peak,
+    k_count,
+):
+    """`_update_range` for K >= 2 Kelvin elements, ``k_count`` = wl.shape[1] (a literal from
+    `_update_range` for small K); the element loops over unsigned indices (`_u`)."""
     e = coef[_C_E]
     phi1 = coef[_C_PHI1]
     chi = coef[_C_CHI]
@@ -1006,8 +1042,8 @@ def _update_range(
     decay = coef[_C_DECAY]
     z = coef[_C_Z]
     zb = coef[_C_ZB]
-    for i in range(lo, min(hi, n_in)):
-        work = _chain_in_contact(
+    for i in range(_u(lo), _u(max(min(hi, n_in), lo))):
+        work = _chain_in_contact_k(
             wl,
             wsum,
             wb,
@@ -1028,12 +1064,13 @@ def _update_range(
             cff,
             z,
             zb,
+            k_count,
         )
         diss[i] = 2.0 * dx * work
         total += diss[i]
         peak = max(peak, abs(wsum[i]))
-    for i in range(max(lo, n_in), hi):
-        diss[i] = dx * _chain_free(wl, wsum, wb, bsum, i, decay, e_kelvin)
+    for i in range(_u(max(lo, n_in)), _u(max(hi, lo, n_in))):
+        diss[i] = dx * _chain_free_k(wl, wsum, wb, bsum, i, decay, e_kelvin, k_count)
         total += diss[i]
         peak = max(peak, abs(wsum[i]))
     return total, peak
