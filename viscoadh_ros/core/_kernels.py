@@ -115,6 +115,18 @@ TOUCH_BLOCK = 32
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
+def _u(index):
+    """``index`` (>= 0) as an unsigned integer, for the bounds of element loops that should
+    vectorise (0.5.0): numba wraps a negative signed index around (``i < 0: i += n``), and with a
+    loop that starts at a runtime bound LLVM cannot prove that never happens, so it saw every
+    array access as indirect and vectorised nothing ("unsafe indirect dependence"; the K = 1
+    update ran at 4.3 ns per element with a runtime start, 1.9 with a literal 0). An unsigned
+    index has no wraparound. Only for bounds known to be >= 0; mix it only with unsigned
+    values (numba types uint64 + int64 as float64)."""
+    return numba.uint64(index)
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
 def _phi(x: float) -> tuple:
     """Return ``(exp(-x), (1-exp(-x))/x, (x-1+exp(-x))/x^2)`` for x >= 0, safe at both ends."""
     if x < _SERIES_LIMIT:
@@ -731,6 +743,18 @@ def _chain_in_contact(
     ``dz/dt = zeta0 E(t) + beta slope F(t)``: a sum of non-negative terms (each term is the
     integral of a square; rounding below zero is cut)."""
     k_count = wl.shape[1]
+    return _chain_in_contact_k(
+        wl, wsum, wb, bsum, i, u0, u1, slope, p, p_inv, lam, beta, e, phi1, chi, cee, cef, cff, z, zb, k_count
+    )
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
+def _chain_in_contact_k(
+    wl, wsum, wb, bsum, i, u0, u1, slope, p, p_inv, lam, beta, e, phi1, chi, cee, cef, cff, z, zb, k_count
+):
+    """`_chain_in_contact` with the Kelvin count ``k_count`` (= wl.shape[1]) given: called with a
+    literal K (`_update_range`) the mode loops have a known length and are unrolled (0.5.0).
+    The same operations in the same order either way (the same bits)."""
     work = 0.0
     for m in range(k_count):
         acc = 0.0
@@ -766,10 +790,16 @@ def _chain_in_contact(
 def _chain_free(wl, wsum, wb, bsum, i, decay, e_kelvin):
     """Element i out of contact: each Kelvin element creeps back by its factor `decay`.
     Returns the Kelvin energy per unit width its dampers took, ``sum_k E_k (l^2 - l'^2)``."""
+    return _chain_free_k(wl, wsum, wb, bsum, i, decay, e_kelvin, wl.shape[1])
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
+def _chain_free_k(wl, wsum, wb, bsum, i, decay, e_kelvin, k_count):
+    """`_chain_free` with the Kelvin count given (see `_chain_in_contact_k`)."""
     total = 0.0
     total_b = 0.0
     lost = 0.0
-    for k in range(wl.shape[1]):
+    for k in range(k_count):
         before = wl[i, k]
         wl[i, k] = before * decay[k]
         wb[i, k] *= decay[k]
@@ -839,21 +869,24 @@ def _sum_losses(diss, wsum, lo, hi, total, peak):
     p1 = peak
     p2 = peak
     p3 = peak
-    i = lo
-    while i + 4 <= hi:
+    one = _u(1)
+    four = _u(4)
+    end = _u(hi)
+    i = _u(lo)
+    while i + four <= end:
         s0 += diss[i]
-        s1 += diss[i + 1]
-        s2 += diss[i + 2]
-        s3 += diss[i + 3]
+        s1 += diss[i + one]
+        s2 += diss[i + _u(2)]
+        s3 += diss[i + _u(3)]
         p0 = max(p0, abs(wsum[i]))
-        p1 = max(p1, abs(wsum[i + 1]))
-        p2 = max(p2, abs(wsum[i + 2]))
-        p3 = max(p3, abs(wsum[i + 3]))
-        i += 4
-    while i < hi:
+        p1 = max(p1, abs(wsum[i + one]))
+        p2 = max(p2, abs(wsum[i + _u(2)]))
+        p3 = max(p3, abs(wsum[i + _u(3)]))
+        i += four
+    while i < end:
         s0 += diss[i]
         p0 = max(p0, abs(wsum[i]))
-        i += 1
+        i += one
     return total + ((s0 + s1) + (s2 + s3)), max(max(p0, p1), max(p2, p3))
 
 
@@ -902,7 +935,7 @@ def _update_range_one(
     decay_0 = coef[_C_DECAY, 0]
     ek_0 = e_kelvin[0]
     mid = max(min(hi, n_in), lo)
-    for i in range(lo, mid):
+    for i in range(_u(lo), _u(mid)):
         u0 = d0 - g_c[i]
         u1 = d1 - g_c[i]
         acc = 0.0 + p00 * w[i]
@@ -920,7 +953,7 @@ def _update_range_one(
         wsum[i] = 0.0 + new
         bsum[i] = 0.0 + new_b
         diss[i] = 2.0 * dx * work
-    for i in range(mid, hi):
+    for i in range(_u(mid), _u(hi)):
         before = w[i]
         after = before * decay_0
         w[i] = after
@@ -959,30 +992,62 @@ def _update_range(
     `_substep_coefficients`); returns ``(total, peak)``: ``total`` plus the energy they
     dissipated, J (K >= 2: added element by element in index order; K = 1: in four lanes,
     `_sum_losses`), and the larger of ``peak`` and their largest |wsum|, m."""
-    if wl.shape[1] == 1:
-        return _update_range_one(
-            wl,
-            wsum,
-            wb,
-            bsum,
-            diss,
-            lo,
-            hi,
-            n_in,
-            d0,
-            d1,
-            slope,
-            g_c,
-            p,
-            p_inv,
-            lam,
-            beta,
-            coef,
-            e_kelvin,
-            dx,
-            total,
-            peak,
-        )
+    k_count = wl.shape[1]
+    args = (wl, wsum, wb, bsum, diss, lo, hi, n_in, d0, d1, slope, g_c, p, p_inv, lam, beta, coef)
+    args = (*args, e_kelvin, dx)
+    if k_count == 1:
+        return _update_range_one(*args, total, peak)
+    if k_count < 2 or k_count > 4:
+        return _update_range_k(*args, total, peak, k_count)
+    # K = 2, 3, 4: the element loops written out per K (generated, `_update_in_4`...): the modes
+    # in registers, no workspace, a known stride, so the compiler vectorises across elements;
+    # the losses and the peak summed after, in index order (0.5.0; the same bits).
+    mid = max(min(hi, n_in), lo)
+    end = max(hi, mid)
+    in_args = (wl, wsum, wb, bsum, diss, lo, mid, d0, d1, slope, g_c, p, p_inv, lam, beta, coef, dx)
+    free_args = (wl, wsum, wb, bsum, diss, mid, end, coef[_C_DECAY], e_kelvin, dx)
+    if k_count == 2:
+        _update_in_2(*in_args)
+        _update_free_2(*free_args)
+    elif k_count == 3:
+        _update_in_3(*in_args)
+        _update_free_3(*free_args)
+    else:
+        _update_in_4(*in_args)
+        _update_free_4(*free_args)
+    for i in range(_u(lo), _u(end)):
+        total += diss[i]
+        peak = max(peak, abs(wsum[i]))
+    return total, peak
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _update_range_k(
+    wl,
+    wsum,
+    wb,
+    bsum,
+    diss,
+    lo,
+    hi,
+    n_in,
+    d0,
+    d1,
+    slope,
+    g_c,
+    p,
+    p_inv,
+    lam,
+    beta,
+    coef,
+    e_kelvin,
+    dx,
+    total,
+    peak,
+    k_count,
+):
+    """`_update_range` for K >= 2 Kelvin elements, ``k_count`` = wl.shape[1] (a literal from
+    `_update_range` for small K); the element loops over unsigned indices (`_u`)."""
     e = coef[_C_E]
     phi1 = coef[_C_PHI1]
     chi = coef[_C_CHI]
@@ -992,8 +1057,8 @@ def _update_range(
     decay = coef[_C_DECAY]
     z = coef[_C_Z]
     zb = coef[_C_ZB]
-    for i in range(lo, min(hi, n_in)):
-        work = _chain_in_contact(
+    for i in range(_u(lo), _u(max(min(hi, n_in), lo))):
+        work = _chain_in_contact_k(
             wl,
             wsum,
             wb,
@@ -1014,15 +1079,571 @@ def _update_range(
             cff,
             z,
             zb,
+            k_count,
         )
         diss[i] = 2.0 * dx * work
         total += diss[i]
         peak = max(peak, abs(wsum[i]))
-    for i in range(max(lo, n_in), hi):
-        diss[i] = dx * _chain_free(wl, wsum, wb, bsum, i, decay, e_kelvin)
+    for i in range(_u(max(lo, n_in)), _u(max(hi, lo, n_in))):
+        diss[i] = dx * _chain_free_k(wl, wsum, wb, bsum, i, decay, e_kelvin, k_count)
         total += diss[i]
         peak = max(peak, abs(wsum[i]))
     return total, peak
+
+
+# --- generated by scripts/gen_kelvin_update.py: do not edit by hand ---
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _update_in_2(wl, wsum, wb, bsum, diss, lo, mid, d0, d1, slope, g_c, p, p_inv, lam, beta, coef, dx):
+    """In-contact elements lo..mid-1 of `_update_range_k` for K = 2, written out."""
+    n = wl.shape[0]
+    w = wl.reshape(n * 2)
+    v = wb.reshape(n * 2)
+    p00 = p[0, 0]
+    p01 = p[0, 1]
+    p10 = p[1, 0]
+    p11 = p[1, 1]
+    q00 = p_inv[0, 0]
+    q01 = p_inv[0, 1]
+    q10 = p_inv[1, 0]
+    q11 = p_inv[1, 1]
+    lam0 = lam[0]
+    beta0 = beta[0]
+    e0 = coef[_C_E, 0]
+    phi0 = coef[_C_PHI1, 0]
+    chi0 = coef[_C_CHI, 0]
+    cee0 = coef[_C_EE, 0]
+    cef0 = coef[_C_EF, 0]
+    cff0 = coef[_C_FF, 0]
+    lam1 = lam[1]
+    beta1 = beta[1]
+    e1 = coef[_C_E, 1]
+    phi1 = coef[_C_PHI1, 1]
+    chi1 = coef[_C_CHI, 1]
+    cee1 = coef[_C_EE, 1]
+    cef1 = coef[_C_EF, 1]
+    cff1 = coef[_C_FF, 1]
+    two_dx = 2.0 * dx
+    for i in range(_u(lo), _u(mid)):
+        at = i * _u(2)
+        w0 = w[at]
+        v0 = v[at]
+        w1 = w[at + _u(1)]
+        v1 = v[at + _u(1)]
+        u0 = d0 - g_c[i]
+        u1 = d1 - g_c[i]
+        work = 0.0
+        acc = 0.0 + p00 * w0
+        acc_b = 0.0 + p00 * v0
+        acc = acc + p01 * w1
+        acc_b = acc_b + p01 * v1
+        z0 = e0 * acc + beta0 * (u0 * phi0 + (u1 - u0) * chi0)
+        zb0 = e0 * acc_b + beta0 * phi0
+        zeta = beta0 * u0 - lam0 * acc
+        b = beta0 * slope
+        q = zeta * zeta * cee0 + 2.0 * zeta * b * cef0 + b * b * cff0
+        work = work + q if q > 0.0 else work
+        acc = 0.0 + p10 * w0
+        acc_b = 0.0 + p10 * v0
+        acc = acc + p11 * w1
+        acc_b = acc_b + p11 * v1
+        z1 = e1 * acc + beta1 * (u0 * phi1 + (u1 - u0) * chi1)
+        zb1 = e1 * acc_b + beta1 * phi1
+        zeta = beta1 * u0 - lam1 * acc
+        b = beta1 * slope
+        q = zeta * zeta * cee1 + 2.0 * zeta * b * cef1 + b * b * cff1
+        work = work + q if q > 0.0 else work
+        total = 0.0
+        total_b = 0.0
+        acc = 0.0 + q00 * z0
+        acc_b = 0.0 + q00 * zb0
+        acc = acc + q01 * z1
+        acc_b = acc_b + q01 * zb1
+        w[at] = acc
+        v[at] = acc_b
+        total = total + acc
+        total_b = total_b + acc_b
+        acc = 0.0 + q10 * z0
+        acc_b = 0.0 + q10 * zb0
+        acc = acc + q11 * z1
+        acc_b = acc_b + q11 * zb1
+        w[at + _u(1)] = acc
+        v[at + _u(1)] = acc_b
+        total = total + acc
+        total_b = total_b + acc_b
+        wsum[i] = total
+        bsum[i] = total_b
+        diss[i] = two_dx * work
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _update_free_2(wl, wsum, wb, bsum, diss, lo, hi, decay, e_kelvin, dx):
+    """Out-of-contact elements lo..hi-1 of `_update_range_k` for K = 2, written out."""
+    n = wl.shape[0]
+    w = wl.reshape(n * 2)
+    v = wb.reshape(n * 2)
+    decay0 = decay[0]
+    ek0 = e_kelvin[0]
+    decay1 = decay[1]
+    ek1 = e_kelvin[1]
+    for i in range(_u(lo), _u(hi)):
+        at = i * _u(2)
+        total = 0.0
+        total_b = 0.0
+        lost = 0.0
+        before = w[at]
+        after = before * decay0
+        w[at] = after
+        after_b = v[at] * decay0
+        v[at] = after_b
+        lost = lost + ek0 * (before * before - after * after)
+        total = total + after
+        total_b = total_b + after_b
+        before = w[at + _u(1)]
+        after = before * decay1
+        w[at + _u(1)] = after
+        after_b = v[at + _u(1)] * decay1
+        v[at + _u(1)] = after_b
+        lost = lost + ek1 * (before * before - after * after)
+        total = total + after
+        total_b = total_b + after_b
+        wsum[i] = total
+        bsum[i] = total_b
+        diss[i] = dx * lost
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _update_in_3(wl, wsum, wb, bsum, diss, lo, mid, d0, d1, slope, g_c, p, p_inv, lam, beta, coef, dx):
+    """In-contact elements lo..mid-1 of `_update_range_k` for K = 3, written out."""
+    n = wl.shape[0]
+    w = wl.reshape(n * 3)
+    v = wb.reshape(n * 3)
+    p00 = p[0, 0]
+    p01 = p[0, 1]
+    p02 = p[0, 2]
+    p10 = p[1, 0]
+    p11 = p[1, 1]
+    p12 = p[1, 2]
+    p20 = p[2, 0]
+    p21 = p[2, 1]
+    p22 = p[2, 2]
+    q00 = p_inv[0, 0]
+    q01 = p_inv[0, 1]
+    q02 = p_inv[0, 2]
+    q10 = p_inv[1, 0]
+    q11 = p_inv[1, 1]
+    q12 = p_inv[1, 2]
+    q20 = p_inv[2, 0]
+    q21 = p_inv[2, 1]
+    q22 = p_inv[2, 2]
+    lam0 = lam[0]
+    beta0 = beta[0]
+    e0 = coef[_C_E, 0]
+    phi0 = coef[_C_PHI1, 0]
+    chi0 = coef[_C_CHI, 0]
+    cee0 = coef[_C_EE, 0]
+    cef0 = coef[_C_EF, 0]
+    cff0 = coef[_C_FF, 0]
+    lam1 = lam[1]
+    beta1 = beta[1]
+    e1 = coef[_C_E, 1]
+    phi1 = coef[_C_PHI1, 1]
+    chi1 = coef[_C_CHI, 1]
+    cee1 = coef[_C_EE, 1]
+    cef1 = coef[_C_EF, 1]
+    cff1 = coef[_C_FF, 1]
+    lam2 = lam[2]
+    beta2 = beta[2]
+    e2 = coef[_C_E, 2]
+    phi2 = coef[_C_PHI1, 2]
+    chi2 = coef[_C_CHI, 2]
+    cee2 = coef[_C_EE, 2]
+    cef2 = coef[_C_EF, 2]
+    cff2 = coef[_C_FF, 2]
+    two_dx = 2.0 * dx
+    for i in range(_u(lo), _u(mid)):
+        at = i * _u(3)
+        w0 = w[at]
+        v0 = v[at]
+        w1 = w[at + _u(1)]
+        v1 = v[at + _u(1)]
+        w2 = w[at + _u(2)]
+        v2 = v[at + _u(2)]
+        u0 = d0 - g_c[i]
+        u1 = d1 - g_c[i]
+        work = 0.0
+        acc = 0.0 + p00 * w0
+        acc_b = 0.0 + p00 * v0
+        acc = acc + p01 * w1
+        acc_b = acc_b + p01 * v1
+        acc = acc + p02 * w2
+        acc_b = acc_b + p02 * v2
+        z0 = e0 * acc + beta0 * (u0 * phi0 + (u1 - u0) * chi0)
+        zb0 = e0 * acc_b + beta0 * phi0
+        zeta = beta0 * u0 - lam0 * acc
+        b = beta0 * slope
+        q = zeta * zeta * cee0 + 2.0 * zeta * b * cef0 + b * b * cff0
+        work = work + q if q > 0.0 else work
+        acc = 0.0 + p10 * w0
+        acc_b = 0.0 + p10 * v0
+        acc = acc + p11 * w1
+        acc_b = acc_b + p11 * v1
+        acc = acc + p12 * w2
+        acc_b = acc_b + p12 * v2
+        z1 = e1 * acc + beta1 * (u0 * phi1 + (u1 - u0) * chi1)
+        zb1 = e1 * acc_b + beta1 * phi1
+        zeta = beta1 * u0 - lam1 * acc
+        b = beta1 * slope
+        q = zeta * zeta * cee1 + 2.0 * zeta * b * cef1 + b * b * cff1
+        work = work + q if q > 0.0 else work
+        acc = 0.0 + p20 * w0
+        acc_b = 0.0 + p20 * v0
+        acc = acc + p21 * w1
+        acc_b = acc_b + p21 * v1
+        acc = acc + p22 * w2
+        acc_b = acc_b + p22 * v2
+        z2 = e2 * acc + beta2 * (u0 * phi2 + (u1 - u0) * chi2)
+        zb2 = e2 * acc_b + beta2 * phi2
+        zeta = beta2 * u0 - lam2 * acc
+        b = beta2 * slope
+        q = zeta * zeta * cee2 + 2.0 * zeta * b * cef2 + b * b * cff2
+        work = work + q if q > 0.0 else work
+        total = 0.0
+        total_b = 0.0
+        acc = 0.0 + q00 * z0
+        acc_b = 0.0 + q00 * zb0
+        acc = acc + q01 * z1
+        acc_b = acc_b + q01 * zb1
+        acc = acc + q02 * z2
+        acc_b = acc_b + q02 * zb2
+        w[at] = acc
+        v[at] = acc_b
+        total = total + acc
+        total_b = total_b + acc_b
+        acc = 0.0 + q10 * z0
+        acc_b = 0.0 + q10 * zb0
+        acc = acc + q11 * z1
+        acc_b = acc_b + q11 * zb1
+        acc = acc + q12 * z2
+        acc_b = acc_b + q12 * zb2
+        w[at + _u(1)] = acc
+        v[at + _u(1)] = acc_b
+        total = total + acc
+        total_b = total_b + acc_b
+        acc = 0.0 + q20 * z0
+        acc_b = 0.0 + q20 * zb0
+        acc = acc + q21 * z1
+        acc_b = acc_b + q21 * zb1
+        acc = acc + q22 * z2
+        acc_b = acc_b + q22 * zb2
+        w[at + _u(2)] = acc
+        v[at + _u(2)] = acc_b
+        total = total + acc
+        total_b = total_b + acc_b
+        wsum[i] = total
+        bsum[i] = total_b
+        diss[i] = two_dx * work
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _update_free_3(wl, wsum, wb, bsum, diss, lo, hi, decay, e_kelvin, dx):
+    """Out-of-contact elements lo..hi-1 of `_update_range_k` for K = 3, written out."""
+    n = wl.shape[0]
+    w = wl.reshape(n * 3)
+    v = wb.reshape(n * 3)
+    decay0 = decay[0]
+    ek0 = e_kelvin[0]
+    decay1 = decay[1]
+    ek1 = e_kelvin[1]
+    decay2 = decay[2]
+    ek2 = e_kelvin[2]
+    for i in range(_u(lo), _u(hi)):
+        at = i * _u(3)
+        total = 0.0
+        total_b = 0.0
+        lost = 0.0
+        before = w[at]
+        after = before * decay0
+        w[at] = after
+        after_b = v[at] * decay0
+        v[at] = after_b
+        lost = lost + ek0 * (before * before - after * after)
+        total = total + after
+        total_b = total_b + after_b
+        before = w[at + _u(1)]
+        after = before * decay1
+        w[at + _u(1)] = after
+        after_b = v[at + _u(1)] * decay1
+        v[at + _u(1)] = after_b
+        lost = lost + ek1 * (before * before - after * after)
+        total = total + after
+        total_b = total_b + after_b
+        before = w[at + _u(2)]
+        after = before * decay2
+        w[at + _u(2)] = after
+        after_b = v[at + _u(2)] * decay2
+        v[at + _u(2)] = after_b
+        lost = lost + ek2 * (before * before - after * after)
+        total = total + after
+        total_b = total_b + after_b
+        wsum[i] = total
+        bsum[i] = total_b
+        diss[i] = dx * lost
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _update_in_4(wl, wsum, wb, bsum, diss, lo, mid, d0, d1, slope, g_c, p, p_inv, lam, beta, coef, dx):
+    """In-contact elements lo..mid-1 of `_update_range_k` for K = 4, written out."""
+    n = wl.shape[0]
+    w = wl.reshape(n * 4)
+    v = wb.reshape(n * 4)
+    p00 = p[0, 0]
+    p01 = p[0, 1]
+    p02 = p[0, 2]
+    p03 = p[0, 3]
+    p10 = p[1, 0]
+    p11 = p[1, 1]
+    p12 = p[1, 2]
+    p13 = p[1, 3]
+    p20 = p[2, 0]
+    p21 = p[2, 1]
+    p22 = p[2, 2]
+    p23 = p[2, 3]
+    p30 = p[3, 0]
+    p31 = p[3, 1]
+    p32 = p[3, 2]
+    p33 = p[3, 3]
+    q00 = p_inv[0, 0]
+    q01 = p_inv[0, 1]
+    q02 = p_inv[0, 2]
+    q03 = p_inv[0, 3]
+    q10 = p_inv[1, 0]
+    q11 = p_inv[1, 1]
+    q12 = p_inv[1, 2]
+    q13 = p_inv[1, 3]
+    q20 = p_inv[2, 0]
+    q21 = p_inv[2, 1]
+    q22 = p_inv[2, 2]
+    q23 = p_inv[2, 3]
+    q30 = p_inv[3, 0]
+    q31 = p_inv[3, 1]
+    q32 = p_inv[3, 2]
+    q33 = p_inv[3, 3]
+    lam0 = lam[0]
+    beta0 = beta[0]
+    e0 = coef[_C_E, 0]
+    phi0 = coef[_C_PHI1, 0]
+    chi0 = coef[_C_CHI, 0]
+    cee0 = coef[_C_EE, 0]
+    cef0 = coef[_C_EF, 0]
+    cff0 = coef[_C_FF, 0]
+    lam1 = lam[1]
+    beta1 = beta[1]
+    e1 = coef[_C_E, 1]
+    phi1 = coef[_C_PHI1, 1]
+    chi1 = coef[_C_CHI, 1]
+    cee1 = coef[_C_EE, 1]
+    cef1 = coef[_C_EF, 1]
+    cff1 = coef[_C_FF, 1]
+    lam2 = lam[2]
+    beta2 = beta[2]
+    e2 = coef[_C_E, 2]
+    phi2 = coef[_C_PHI1, 2]
+    chi2 = coef[_C_CHI, 2]
+    cee2 = coef[_C_EE, 2]
+    cef2 = coef[_C_EF, 2]
+    cff2 = coef[_C_FF, 2]
+    lam3 = lam[3]
+    beta3 = beta[3]
+    e3 = coef[_C_E, 3]
+    phi3 = coef[_C_PHI1, 3]
+    chi3 = coef[_C_CHI, 3]
+    cee3 = coef[_C_EE, 3]
+    cef3 = coef[_C_EF, 3]
+    cff3 = coef[_C_FF, 3]
+    two_dx = 2.0 * dx
+    for i in range(_u(lo), _u(mid)):
+        at = i * _u(4)
+        w0 = w[at]
+        v0 = v[at]
+        w1 = w[at + _u(1)]
+        v1 = v[at + _u(1)]
+        w2 = w[at + _u(2)]
+        v2 = v[at + _u(2)]
+        w3 = w[at + _u(3)]
+        v3 = v[at + _u(3)]
+        u0 = d0 - g_c[i]
+        u1 = d1 - g_c[i]
+        work = 0.0
+        acc = 0.0 + p00 * w0
+        acc_b = 0.0 + p00 * v0
+        acc = acc + p01 * w1
+        acc_b = acc_b + p01 * v1
+        acc = acc + p02 * w2
+        acc_b = acc_b + p02 * v2
+        acc = acc + p03 * w3
+        acc_b = acc_b + p03 * v3
+        z0 = e0 * acc + beta0 * (u0 * phi0 + (u1 - u0) * chi0)
+        zb0 = e0 * acc_b + beta0 * phi0
+        zeta = beta0 * u0 - lam0 * acc
+        b = beta0 * slope
+        q = zeta * zeta * cee0 + 2.0 * zeta * b * cef0 + b * b * cff0
+        work = work + q if q > 0.0 else work
+        acc = 0.0 + p10 * w0
+        acc_b = 0.0 + p10 * v0
+        acc = acc + p11 * w1
+        acc_b = acc_b + p11 * v1
+        acc = acc + p12 * w2
+        acc_b = acc_b + p12 * v2
+        acc = acc + p13 * w3
+        acc_b = acc_b + p13 * v3
+        z1 = e1 * acc + beta1 * (u0 * phi1 + (u1 - u0) * chi1)
+        zb1 = e1 * acc_b + beta1 * phi1
+        zeta = beta1 * u0 - lam1 * acc
+        b = beta1 * slope
+        q = zeta * zeta * cee1 + 2.0 * zeta * b * cef1 + b * b * cff1
+        work = work + q if q > 0.0 else work
+        acc = 0.0 + p20 * w0
+        acc_b = 0.0 + p20 * v0
+        acc = acc + p21 * w1
+        acc_b = acc_b + p21 * v1
+        acc = acc + p22 * w2
+        acc_b = acc_b + p22 * v2
+        acc = acc + p23 * w3
+        acc_b = acc_b + p23 * v3
+        z2 = e2 * acc + beta2 * (u0 * phi2 + (u1 - u0) * chi2)
+        zb2 = e2 * acc_b + beta2 * phi2
+        zeta = beta2 * u0 - lam2 * acc
+        b = beta2 * slope
+        q = zeta * zeta * cee2 + 2.0 * zeta * b * cef2 + b * b * cff2
+        work = work + q if q > 0.0 else work
+        acc = 0.0 + p30 * w0
+        acc_b = 0.0 + p30 * v0
+        acc = acc + p31 * w1
+        acc_b = acc_b + p31 * v1
+        acc = acc + p32 * w2
+        acc_b = acc_b + p32 * v2
+        acc = acc + p33 * w3
+        acc_b = acc_b + p33 * v3
+        z3 = e3 * acc + beta3 * (u0 * phi3 + (u1 - u0) * chi3)
+        zb3 = e3 * acc_b + beta3 * phi3
+        zeta = beta3 * u0 - lam3 * acc
+        b = beta3 * slope
+        q = zeta * zeta * cee3 + 2.0 * zeta * b * cef3 + b * b * cff3
+        work = work + q if q > 0.0 else work
+        total = 0.0
+        total_b = 0.0
+        acc = 0.0 + q00 * z0
+        acc_b = 0.0 + q00 * zb0
+        acc = acc + q01 * z1
+        acc_b = acc_b + q01 * zb1
+        acc = acc + q02 * z2
+        acc_b = acc_b + q02 * zb2
+        acc = acc + q03 * z3
+        acc_b = acc_b + q03 * zb3
+        w[at] = acc
+        v[at] = acc_b
+        total = total + acc
+        total_b = total_b + acc_b
+        acc = 0.0 + q10 * z0
+        acc_b = 0.0 + q10 * zb0
+        acc = acc + q11 * z1
+        acc_b = acc_b + q11 * zb1
+        acc = acc + q12 * z2
+        acc_b = acc_b + q12 * zb2
+        acc = acc + q13 * z3
+        acc_b = acc_b + q13 * zb3
+        w[at + _u(1)] = acc
+        v[at + _u(1)] = acc_b
+        total = total + acc
+        total_b = total_b + acc_b
+        acc = 0.0 + q20 * z0
+        acc_b = 0.0 + q20 * zb0
+        acc = acc + q21 * z1
+        acc_b = acc_b + q21 * zb1
+        acc = acc + q22 * z2
+        acc_b = acc_b + q22 * zb2
+        acc = acc + q23 * z3
+        acc_b = acc_b + q23 * zb3
+        w[at + _u(2)] = acc
+        v[at + _u(2)] = acc_b
+        total = total + acc
+        total_b = total_b + acc_b
+        acc = 0.0 + q30 * z0
+        acc_b = 0.0 + q30 * zb0
+        acc = acc + q31 * z1
+        acc_b = acc_b + q31 * zb1
+        acc = acc + q32 * z2
+        acc_b = acc_b + q32 * zb2
+        acc = acc + q33 * z3
+        acc_b = acc_b + q33 * zb3
+        w[at + _u(3)] = acc
+        v[at + _u(3)] = acc_b
+        total = total + acc
+        total_b = total_b + acc_b
+        wsum[i] = total
+        bsum[i] = total_b
+        diss[i] = two_dx * work
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _update_free_4(wl, wsum, wb, bsum, diss, lo, hi, decay, e_kelvin, dx):
+    """Out-of-contact elements lo..hi-1 of `_update_range_k` for K = 4, written out."""
+    n = wl.shape[0]
+    w = wl.reshape(n * 4)
+    v = wb.reshape(n * 4)
+    decay0 = decay[0]
+    ek0 = e_kelvin[0]
+    decay1 = decay[1]
+    ek1 = e_kelvin[1]
+    decay2 = decay[2]
+    ek2 = e_kelvin[2]
+    decay3 = decay[3]
+    ek3 = e_kelvin[3]
+    for i in range(_u(lo), _u(hi)):
+        at = i * _u(4)
+        total = 0.0
+        total_b = 0.0
+        lost = 0.0
+        before = w[at]
+        after = before * decay0
+        w[at] = after
+        after_b = v[at] * decay0
+        v[at] = after_b
+        lost = lost + ek0 * (before * before - after * after)
+        total = total + after
+        total_b = total_b + after_b
+        before = w[at + _u(1)]
+        after = before * decay1
+        w[at + _u(1)] = after
+        after_b = v[at + _u(1)] * decay1
+        v[at + _u(1)] = after_b
+        lost = lost + ek1 * (before * before - after * after)
+        total = total + after
+        total_b = total_b + after_b
+        before = w[at + _u(2)]
+        after = before * decay2
+        w[at + _u(2)] = after
+        after_b = v[at + _u(2)] * decay2
+        v[at + _u(2)] = after_b
+        lost = lost + ek2 * (before * before - after * after)
+        total = total + after
+        total_b = total_b + after_b
+        before = w[at + _u(3)]
+        after = before * decay3
+        w[at + _u(3)] = after
+        after_b = v[at + _u(3)] * decay3
+        v[at + _u(3)] = after_b
+        lost = lost + ek3 * (before * before - after * after)
+        total = total + after
+        total_b = total_b + after_b
+        wsum[i] = total
+        bsum[i] = total_b
+        diss[i] = dx * lost
+
+
+# --- end of generated code ---
 
 
 @numba.njit(cache=True, nogil=True)  # allocates its workspace: needs the runtime
@@ -1248,11 +1869,11 @@ def _copy_range(src, src_b, dst, dst_b, lo, hi):
     k_count = src.shape[1]
     flat_src = src.reshape(size)
     flat_dst = dst.reshape(size)
-    for j in range(lo * k_count, hi * k_count):
+    for j in range(_u(lo * k_count), _u(hi * k_count)):
         flat_dst[j] = flat_src[j]
     flat_src = src_b.reshape(size)
     flat_dst = dst_b.reshape(size)
-    for j in range(lo * k_count, hi * k_count):
+    for j in range(_u(lo * k_count), _u(hi * k_count)):
         flat_dst[j] = flat_src[j]
 
 
@@ -1990,7 +2611,7 @@ def _advance_from(
         )
         if k_count:
             # ... the window (retimed where the edge crossed), then the elements after it.
-            for i in range(lo, hi):
+            for i in range(_u(lo), _u(hi)):
                 viscous += diss[i]
                 peak = max(peak, abs(wsum[i]))
             viscous, peak = _update_range(
