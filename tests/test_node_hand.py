@@ -87,7 +87,11 @@ class _Client:
             ),
             TIMEOUT,
         ), "the node's hand topics did not match"
-        self.t0 = self.node.get_clock().now().nanoseconds + 10**9
+        # Stamps 20 s ahead of the clock (the scene allows 30): the node's 1 Hz hold timer steps
+        # a contact to "now" once the clock passes its last command, so with stamps only 1 s
+        # ahead a test slowed past 1 s by a loaded machine saw its next command refused as
+        # older than that (a flaky failure seen twice in full runs at load ~9).
+        self.t0 = self.node.get_clock().now().nanoseconds + 20 * 10**9
 
     def send(self, msg: HandCommand) -> HandState | None:
         """Publish one hand command; its HandState, or None when an event came instead."""
