@@ -85,7 +85,14 @@ class _Session:
 @pytest.fixture(scope="module")
 def node_log(tmp_path_factory: pytest.TempPathFactory) -> Path:
     log = tmp_path_factory.mktemp("node_events") / "session.mcap"
-    with node_in_process(SCENE, use_sim_time=True, **{"log.enabled": True, "log.path": str(log)}) as (
+    with node_in_process(
+        SCENE,
+        use_sim_time=True,
+        # The driver moves /clock after each answer; the next command may reach the node before
+        # that clock (two topics, no order between them): at the first step, 1.0 -> 1.01 s on a
+        # clock still at 0, 1.01 s ahead, was refused under the default 1 s (a CI failure).
+        **{"log.enabled": True, "log.path": str(log), "command.max_future_s": 30.0},
+    ) as (
         context,
         executor,
     ):

@@ -51,6 +51,8 @@ from viscoadh_ros.ros.node import GIL_SWITCH_INTERVAL_S, ViscoadhNode
 _DISCOVERY_RANGE = "ROS_AUTOMATIC_DISCOVERY_RANGE"
 #: The simulated clock starts here, s: a zero stamp would mean "now" to the node.
 _CLOCK_START_S = 1.0
+#: How far ahead of the node's clock the demo's node accepts commands, s (see `run_demo`).
+DRIVER_MAX_FUTURE_S = 30.0
 #: How long the driver waits for any one answer of the node, s (wall clock).
 _TIMEOUT_S = 10.0
 
@@ -488,7 +490,12 @@ def run_demo(*, scene_path: Path | None = None, out_dir: Path, contact_id: str |
     log_path = (out_dir / "demo.mcap").resolve()
     figure_path = (out_dir / "demo.png").resolve()
     log_path.unlink(missing_ok=True)
-    with node_in_process(scene, use_sim_time=True, **{"log.enabled": True, "log.path": str(log_path)}) as (
+    # The driver moves /clock after each answer, and the next command may reach the node before
+    # that clock does (two topics, no order between them): from the clock's first value (0) the
+    # second command is more than the default 1 s ahead. The demo drives the clock itself, so the
+    # node allows commands up to DRIVER_MAX_FUTURE_S ahead of it.
+    overrides = {"log.enabled": True, "log.path": str(log_path), "command.max_future_s": DRIVER_MAX_FUTURE_S}
+    with node_in_process(scene, use_sim_time=True, **overrides) as (
         context,
         executor,
     ):
