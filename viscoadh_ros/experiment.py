@@ -332,21 +332,12 @@ def _refuse_hand_driven(bag: Bag, inputs: str) -> None:
     topics = bag.topics_of_type(cdr.HAND_COMMAND)
     if not topics:
         return
-    contact = inputs.rstrip("/").rsplit("/", 2)[-2] if inputs.count("/") >= 1 else ""
-    if not contact:
+    path = inputs.strip("/").split("/")
+    if len(path) < 2:
         return
-    # The id as CDR writes it inside contact_ids (length with its NUL, the bytes, the NUL): a
-    # substring search finds the candidates, the parser confirms.
-    encoded = contact.encode()
-    needle = (len(encoded) + 1).to_bytes(4, "little") + encoded + b"\0"
+    contact = path[-2]
     for topic in topics:
-        count = 0
-        for payload in bag.raw(topic)[2]:
-            if needle not in payload:
-                continue
-            parsed = cdr.parse_hand_command(payload)
-            if parsed is None or contact in parsed[2]:
-                count += 1
+        count = sum(cdr.hand_command_names(payload, contact) for payload in bag.raw(topic)[2])
         if count:
             raise InputError(
                 f"contact {contact!r} was also stepped by hand commands ({count} on {topic!r}): replay "

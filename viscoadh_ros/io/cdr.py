@@ -206,6 +206,22 @@ def parse_hand_command(
     return sec, nanosec, tuple(ids), mode, arrays[0], arrays[1]
 
 
+def string_bytes(text: bytes) -> bytes:
+    """``text`` as a CDR string, without the alignment padding before it: its length with the
+    terminating NUL (uint32, little-endian), the bytes, the NUL."""
+    return _U32.pack(len(text) + 1) + text + b"\x00"
+
+
+def hand_command_names(payload: bytes, contact_id: str) -> bool:
+    """Whether the serialised HandCommand ``payload`` lists ``contact_id``: a byte search for
+    the id as CDR writes it, then the parser (a payload it cannot read counts when the id's
+    bytes are in it)."""
+    if string_bytes(contact_id.encode()) not in payload:
+        return False
+    parsed = parse_hand_command(payload)
+    return parsed is None or contact_id in parsed[2]
+
+
 def decode(
     type_name: str, payloads: Sequence[bytes] | NDArray[np.uint8], fields: Sequence[str] | None = None
 ) -> dict[str, NDArray] | None:
@@ -365,7 +381,7 @@ def _hand_state_layout(frame_id: str, contact_ids: tuple[str, ...]) -> tuple[byt
 
     def put_string(text: bytes) -> None:
         nonlocal position
-        out.extend(bytes(-position % 4) + struct.pack("<I", len(text) + 1) + text + b"\x00")
+        out.extend(bytes(-position % 4) + string_bytes(text))
         position = len(out) - _HEADER
 
     put_string(frame_id.encode())
