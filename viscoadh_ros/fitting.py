@@ -821,35 +821,37 @@ def _profile_cost(
     Jacobian points off it) they take as many again with a forward-secant Jacobian of their own
     at the best point so far (len(others) more runs)."""
     r = problem.residual(trial)
-    cost = linear = float(r @ r)
+    linear = float(r @ r)
     if not others.size:
-        return cost
-    best, best_r = trial, r
-    for attempt in range(2):
-        if attempt:
-            if not (cost - base > 0.0 and linear - base > 2.0 * (cost - base)):
-                break
-            own = []
-            for i in others:
-                h = float(steps[i])
-                shifted = best.copy()
-                shifted[i] = min(shifted[i] + h, upper[i])
-                if shifted[i] == best[i]:
-                    shifted[i] = max(best[i] - h, lower[i])
-                own.append((problem.residual(shifted) - best_r) / (shifted[i] - best[i]))
-            jac_others = np.column_stack(own)
-        else:
-            jac_others = jac[:, others]
-        point, r = best, best_r
+        return linear
+
+    def descend(jac_others: NDArray[np.float64], best: tuple) -> tuple:
+        """PROFILE_BENDS Gauss-Newton steps of the others from ``best`` = (cost, point,
+        residuals); the best of it and them."""
+        point, res = best[1], best[2]
         for _ in range(PROFILE_BENDS):
             point = point.copy()
-            point[others] += np.linalg.lstsq(jac_others, -r, rcond=None)[0]
+            point[others] += np.linalg.lstsq(jac_others, -res, rcond=None)[0]
             point = np.clip(point, lower, upper)
-            r = problem.residual(point)
-            value = float(r @ r)
-            if value < cost:
-                cost, best, best_r = value, point, r
-    return cost
+            res = problem.residual(point)
+            value = float(res @ res)
+            if value < best[0]:
+                best = (value, point, res)
+        return best
+
+    best = descend(jac[:, others], (linear, trial, r))
+    cost, point, res = best
+    if cost - base > 0.0 and linear - base > 2.0 * (cost - base):
+        own = []
+        for i in others:
+            h = float(steps[i])
+            shifted = point.copy()
+            shifted[i] = min(shifted[i] + h, upper[i])
+            if shifted[i] == point[i]:
+                shifted[i] = max(point[i] - h, lower[i])
+            own.append((problem.residual(shifted) - res) / (shifted[i] - point[i]))
+        best = descend(np.column_stack(own), best)
+    return best[0]
 
 
 def _profile_inflation(
@@ -871,8 +873,8 @@ def _profile_inflation(
     off along a banana): there the cost rises faster than along the true profile and the
     interval would come out too narrow (truths 4 % off outside a 1 % interval on a record too
     fast for the Kelvin spring). So at each trial point the other parameters follow the valley
-    (:func:`_profile_cost`) and the lowest cost found counts. 4p (2 + PROFILE_BENDS) model runs
-    at most, plus p more per trial point where the valley curves."""
+    (:func:`_profile_cost`) and the lowest cost found counts. 4p (1 + PROFILE_BENDS) model runs
+    at most, plus p - 1 + PROFILE_BENDS more per trial point where the valley curves."""
     u, cov, r = polished.u, polished.cov, polished.r
     jac = polished.jac
     dof = max(r.size - u.size, 1)
