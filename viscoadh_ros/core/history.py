@@ -169,10 +169,9 @@ def predict_pull_off(simulator: ContactSimulator, retract_speed: float) -> PullO
             # pull-off at 1 d_c, 10 mm/s). The same path again to the row before it, then
             # PULL_OFF_REFINE rows per step across the two steps around it.
             simulator.restore(start)
-            for i in range(1, best - 1):
+            for i in range(1, best):
                 simulator.step(t0 + i * dt, depth=d0 - speed * i * dt)
-            first = max(best - 1, 0) * PULL_OFF_REFINE
-            for k in range(first + 1, (best + 1) * PULL_OFF_REFINE + 1):
+            for k in range((best - 1) * PULL_OFF_REFINE + 1, (best + 1) * PULL_OFF_REFINE + 1):
                 t = k * dt / PULL_OFF_REFINE
                 step = simulator.step(t0 + t, depth=d0 - speed * t)
                 if step.force < best_force:
