@@ -51,3 +51,21 @@ STANDARD_SOLID_FINGER: dict[str, Any] = {
     "finger.numerics.preset": "fast",
     "finger.numerics.model": "time_stepped",
 }
+
+
+def node_contacts_scene(count: int, *, radius_spread: float = 0.0, **node: Any) -> dict[str, Any]:
+    """Node parameters of ``count`` standard-solid spheres ``c0``, ``c1``, ... (fast preset,
+    commands up to 30 s ahead of the clock, 1 Hz publishing) for the node tests: contact k's
+    radius is 5 mm x (1 + ``radius_spread`` k), so contacts can differ; ``node`` adds or
+    overrides node parameters (e.g. ``{"command.queue_depth": 37}``)."""
+    ids = [f"c{k}" for k in range(count)]
+    scene: dict[str, Any] = {"contacts": ids, "publish_rate": 1.0, "command.max_future_s": 30.0, **node}
+    for k, contact_id in enumerate(ids):
+        scene[f"{contact_id}.indenter.shape"] = "sphere"
+        scene[f"{contact_id}.indenter.radius"] = 0.005 * (1.0 + radius_spread * k)
+        scene[f"{contact_id}.material.glass_shear_modulus"] = 1.0e6
+        scene[f"{contact_id}.material.kelvin_shear_moduli"] = [1.0e5]
+        scene[f"{contact_id}.material.kelvin_viscosities"] = [1.1e4]
+        scene[f"{contact_id}.adhesion.work_of_adhesion"] = 0.05
+        scene[f"{contact_id}.numerics.preset"] = "fast"
+    return scene

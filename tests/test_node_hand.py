@@ -15,6 +15,7 @@ import pytest
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.parameter import Parameter
+from scenes import node_contacts_scene
 from viscoadh_msgs.msg import ContactEvent, ContactState, HandCommand, HandState, IndentationCommand
 
 from viscoadh_ros.core.config import SceneConfig
@@ -27,17 +28,7 @@ DEPTH = 40e-6  # m, deepest commanded depth
 
 
 def _scene(count: int) -> dict[str, Any]:
-    ids = [f"c{k}" for k in range(count)]
-    scene: dict[str, Any] = {"contacts": ids, "publish_rate": 1.0, "command.max_future_s": 30.0}
-    for k, contact_id in enumerate(ids):
-        scene[f"{contact_id}.indenter.shape"] = "sphere"
-        scene[f"{contact_id}.indenter.radius"] = 0.005 * (1.0 + 0.1 * k)  # contacts differ
-        scene[f"{contact_id}.material.glass_shear_modulus"] = 1.0e6
-        scene[f"{contact_id}.material.kelvin_shear_moduli"] = [1.0e5]
-        scene[f"{contact_id}.material.kelvin_viscosities"] = [1.1e4]
-        scene[f"{contact_id}.adhesion.work_of_adhesion"] = 0.05
-        scene[f"{contact_id}.numerics.preset"] = "fast"
-    return scene
+    return node_contacts_scene(count, radius_spread=0.1)  # contacts differ
 
 
 def _node(context: Any, scene: dict[str, Any]) -> ViscoadhNode:

@@ -23,6 +23,7 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rclpy.serialization import serialize_message
+from scenes import node_contacts_scene
 from viscoadh_msgs.msg import HandCommand
 
 from viscoadh_ros.core.config import (
@@ -41,17 +42,7 @@ DEPTH = 40e-6  # m
 
 
 def _scene(count: int, **node: Any) -> dict[str, Any]:
-    ids = [f"c{k}" for k in range(count)]
-    scene: dict[str, Any] = {"contacts": ids, "publish_rate": 1.0, "command.max_future_s": 30.0, **node}
-    for contact_id in ids:
-        scene[f"{contact_id}.indenter.shape"] = "sphere"
-        scene[f"{contact_id}.indenter.radius"] = 0.005
-        scene[f"{contact_id}.material.glass_shear_modulus"] = 1.0e6
-        scene[f"{contact_id}.material.kelvin_shear_moduli"] = [1.0e5]
-        scene[f"{contact_id}.material.kelvin_viscosities"] = [1.1e4]
-        scene[f"{contact_id}.adhesion.work_of_adhesion"] = 0.05
-        scene[f"{contact_id}.numerics.preset"] = "fast"
-    return scene
+    return node_contacts_scene(count, **node)
 
 
 def _node(context: Any, scene: dict[str, Any]) -> ViscoadhNode:
