@@ -41,3 +41,33 @@ def test_the_losses_and_the_peak_in_four_lanes(seed: int) -> None:
         assert total >= 0.0
         assert abs(total - exact) <= 2.0 * (hi - lo + 2) * EPS * exact
         assert abs(want_total - exact) <= 2.0 * (hi - lo + 2) * EPS * exact
+
+
+def test_an_elastic_row_keeps_no_memory_so_its_peak_is_not_scanned() -> None:
+    """K = 0 (no Kelvin element): `_advance_from` reports the memory peak as 0 without the O(N)
+    scan of ``wsum`` (0.7.0). That is only right if nothing ever writes a non-zero ``wsum`` on
+    an elastic row: press, snap in, pull off and touch again, per call and in batch, at an
+    element count where the edge races (several substeps per row)."""
+    from tests.scenes import one_contact
+    from viscoadh_ros.core.simulator import ContactSimulator
+
+    contact = one_contact(
+        {"shape": "sphere", "radius": 0.01},
+        work=0.05,
+        numerics={"elements": 2048, "model": "time_stepped"},
+    )
+    t = 1e-3 * np.arange(1, 501)
+    depth = 4e-5 * np.sin(2.0 * np.pi * t / 0.4) - 5e-6  # ends pressed, after a pull-off
+    per_call = ContactSimulator(contact)
+    for time, d in zip(t, depth, strict=True):
+        output = per_call.step(float(time), depth=float(d))
+        assert output.energy_dissipated >= 0.0
+    batch = ContactSimulator(contact)
+    rows = batch.step_depths(t, depth)
+    radius = rows["contact_radius"]
+    assert np.any((radius[:-1] > 0.0) & (radius[1:] == 0.0)) and radius[-1] > 0.0
+    for sim in (per_call, batch):
+        row = sim._model.row
+        assert row.wl.shape[1] == 0
+        assert not np.any(row.wsum) and not np.any(row.bsum)
+        assert row.out[_kernels.OUT_MEMORY] == 0.0
