@@ -15,6 +15,7 @@ from viscoadh_ros.bench import accuracy, kernel, reference_stepper, report, suit
 from viscoadh_ros.bench.latency import measure_round_trips, summarize_node_latency
 from viscoadh_ros.bench.timing import interleaved_medians, latency_summary
 from viscoadh_ros.cli.main import main as cli_main
+from viscoadh_ros.core import _kernels
 from viscoadh_ros.core.simulator import ContactSimulator
 
 TINY = dataclasses.replace(
@@ -96,6 +97,62 @@ def test_kernel_row_is_well_formed(kelvin: int) -> None:
     # 32 elements (a baseline that computed something else would show here).
     assert row["pull_off_rel_diff"] < 0.05, row
     assert row["max_force_diff_rel"] < 0.2, row
+    # Where a batch row goes: every part timed (no update without Kelvin elements).
+    assert row["part_force_us"] > 0.0 and row["part_edge_us"] > 0.0
+    assert (row["part_update_us"] > 0.0) == (kelvin > 0)
+
+
+@pytest.mark.parametrize("kelvin", [1, 4])
+def test_the_timed_parts_do_the_kernels_work(kelvin: int) -> None:
+    """The part loops of the batch-row breakdown compute what the kernel computes (a loop
+    that computed less would make a part look cheap): the update gives `_kelvin_update`'s
+    memory bit for bit, the force and edge loops the kernel functions' own answers."""
+    case = next(c for c in accuracy.cases() if c.name == "standard_solid_pull_off")
+    material = kernel.kelvin_material(case, kelvin)
+    contact = accuracy.contact_config(
+        accuracy.Case(case.name, dict(case.contact, material=material), case.cycle_time, case.closed_form),
+        {"elements": 96, "model": "time_stepped"},
+    )
+    sim = ContactSimulator(contact)
+    for index, d in enumerate(np.linspace(0.0, 1.5, 60) * case.depth_scale):
+        sim.step(index * kernel.STEP_S, depth=float(d))
+    row, radius = sim._model.row, sim._model.radius
+    depth = sim.output.depth * (1.0 + 0.01 * np.sin(np.arange(6.0)))
+    wl0, wb0 = row.memory()
+    runs = kernel._part_runs(row, radius, depth, float(sim.numerics.max_edge_cells * row.dx))
+    runs["part_update"]()
+    got = row.memory()
+    row.set_memory(wl0, wb0)
+    n_in = _kernels._interior_count(radius, row.dx, row.elements)
+    for s in range(1, depth.size):
+        _kernels._kelvin_update(
+            row.wl, row.wsum, row.wb, row.bsum, row.diss, n_in, depth[s - 1], depth[s], kernel.STEP_S,
+            row.g_c, row.p, row.p_inv, row.lam, row.beta, row.rate, row.e_kelvin, row.dx,
+        )  # fmt: skip
+    want = row.memory()
+    assert np.array_equal(got[0], want[0]) and np.array_equal(got[1], want[1])
+    buf = np.empty(row.elements)
+    force = sum(
+        _kernels._force(
+            radius, d, row.wsum, row.bsum, row.dx, row.g_c, row.gf, row.gint, row.df, row.e0, row.kap, buf
+        )
+        for d in depth[1:]
+    )
+    assert kernel._force_parts(
+        radius, depth, row.wsum, row.bsum, row.dx, row.g_c, row.gf, row.gint, row.df, row.e0, row.kap, buf
+    ) == pytest.approx(force, rel=1e-14)
+    edges = sum(
+        _kernels._locate_edge(
+            radius, d, row.wsum, row.bsum, row.dx, row.g_c, row.gf, row.gmin, row.gmax, row.df, row.c_crit,
+            row.reach, 1e-3,
+        )[0]
+        for d in depth[1:]
+    )  # fmt: skip
+    assert edges > 0.0
+    assert kernel._edge_parts(
+        radius, depth, row.wsum, row.bsum, row.dx, row.g_c, row.gf, row.gmin, row.gmax, row.df, row.c_crit,
+        row.reach, 1e-3,
+    ) == pytest.approx(edges, rel=1e-14)  # fmt: skip
 
 
 def test_minimal_stepper_agrees_with_the_product_on_a_pull_off() -> None:

@@ -82,6 +82,84 @@ def _kernel_steps(row_args, radius, depth, dt, max_substep, max_edge_move):  # p
     return substeps
 
 
+# Where a row's time goes (the measured cause beside a missed 2x target): each part of the
+# kernel's row alone, over the same depth history on the same row, compiled loops (not cached,
+# as `_kernel_steps`). The kernel computes these inside its step; timed alone they show which
+# part is already beyond the minimal stepper's whole row.
+@numba.njit
+def _update_parts(wl, wsum, wb, bsum, diss, n_in, depth, dt, g_c, p, p_inv, lam, beta, coef, e_kelvin, dx):
+    """The Kelvin update of every element per row (A and B states, damper work, the losses'
+    sum and the memory peak), with the step's coefficients computed once (the kernel keeps
+    them per step length)."""
+    n = wl.shape[0]
+    total = 0.0
+    for s in range(1, depth.shape[0]):  # pragma: no cover - compiled
+        lost, _ = _kernels._update_range(
+            wl, wsum, wb, bsum, diss, 0, n, n_in, depth[s - 1], depth[s], (depth[s] - depth[s - 1]) / dt,
+            g_c, p, p_inv, lam, beta, coef, e_kelvin, dx, 0.0, 0.0,
+        )  # fmt: skip
+        total += lost
+    return total
+
+
+@numba.njit
+def _force_parts(radius, depth, wsum, bsum, dx, g_c, gf, gint, df, e0, kap, buf):
+    """The contact force (its memory integral) once per row at the row's edge."""
+    total = 0.0
+    for s in range(1, depth.shape[0]):  # pragma: no cover - compiled
+        total += _kernels._force(radius, depth[s], wsum, bsum, dx, g_c, gf, gint, df, e0, kap, buf)
+    return total
+
+
+@numba.njit
+def _edge_parts(radius, depth, wsum, bsum, dx, g_c, gf, gmin, gmax, df, c_crit, reach, max_move):
+    """The edge search once per row from the row's edge (limited to the kernel's edge move)."""
+    total = 0.0
+    for s in range(1, depth.shape[0]):  # pragma: no cover - compiled
+        found, _, _ = _kernels._locate_edge(
+            radius, depth[s], wsum, bsum, dx, g_c, gf, gmin, gmax, df, c_crit, reach, max_move
+        )
+        total += found
+    return total
+
+
+def _part_runs(
+    row: _kernels.Row, radius: float, depth: npt.NDArray[np.float64], max_edge_move: float
+) -> dict:
+    """The timed parts of a row (see `_update_parts`): callables for `interleaved_medians`.
+    The update writes the memory: each run starts from the row's memory as the caller left it
+    (`measure_kernel` sets it before every kernel run)."""
+    n_in = _kernels._interior_count(radius, row.dx, row.elements)
+    runs: dict[str, Any] = {}
+    if row.wl.shape[1]:
+        coef = _kernels.coefficient_workspace(row.wl.shape[1])
+        _kernels._substep_coefficients(row.lam, row.rate, STEP_S, coef)
+
+        def run_update() -> None:
+            _update_parts(
+                row.wl, row.wsum, row.wb, row.bsum, row.diss, n_in, depth, STEP_S, row.g_c,
+                row.p, row.p_inv, row.lam, row.beta, coef, row.e_kelvin, row.dx,
+            )  # fmt: skip
+
+        runs["part_update"] = run_update
+    buf = np.empty(row.elements)
+
+    def run_force() -> None:
+        _force_parts(
+            radius, depth, row.wsum, row.bsum, row.dx, row.g_c, row.gf, row.gint, row.df, row.e0, row.kap, buf
+        )
+
+    def run_edge() -> None:
+        _edge_parts(
+            radius, depth, row.wsum, row.bsum, row.dx, row.g_c, row.gf, row.gmin, row.gmax, row.df,
+            row.c_crit, row.reach, max_edge_move,
+        )  # fmt: skip
+
+    runs["part_force"] = run_force
+    runs["part_edge"] = run_edge
+    return runs
+
+
 def kelvin_material(case: Case, kelvin: int) -> dict[str, Any]:
     """The case's material with `kelvin` Kelvin elements sharing its relaxed modulus.
 
@@ -208,8 +286,13 @@ def measure_kernel(elements: int, kelvin: int, *, steps: int, repeats: int) -> d
     run_bare()
     run_minimal()
     run_batch()
+    row.set_memory(wl0, wb0)
+    parts = _part_runs(row, radius, depth, max_edge_move)
+    for run in parts.values():
+        run()  # compiles outside the timing
     times = interleaved_medians(
-        {"kernel": run_kernel, "bare": run_bare, "minimal": run_minimal, "batch": run_batch}, repeats=repeats
+        {"kernel": run_kernel, "bare": run_bare, "minimal": run_minimal, "batch": run_batch, **parts},
+        repeats=repeats,
     )
 
     # Per call from Python, side by side: the whole `ContactSimulator.step` and the minimal
@@ -254,6 +337,11 @@ def measure_kernel(elements: int, kelvin: int, *, steps: int, repeats: int) -> d
         "batch_us": batch_us,
         "minimal_run_us": minimal_run_us,
         "batch_ratio": batch_us / minimal_run_us,
+        # Where a batch row goes: each part of the kernel's row timed alone (`_part_runs`), us
+        # per row; the rest (substeps beyond the first, retiming, outputs) is what is left.
+        "part_update_us": times.get("part_update", 0.0) / steps * 1e6,
+        "part_force_us": times["part_force"] / steps * 1e6,
+        "part_edge_us": times["part_edge"] / steps * 1e6,
         **agreement,
     }
 

@@ -327,6 +327,52 @@ def render_markdown(results: dict[str, Any], figure: Path | None, notes: str | N
             for item in results["kernel"]
         ]
         lines += _table(["N", "K", "kernel ns", "minimal ns", "bare loop ns", "kernel / bare"], rows)
+        parted = [item for item in results["kernel"] if "part_force_us" in item]
+        if parted:
+            lines += [
+                "",
+                "Where a batch row goes (the measured cause of a missed batch target): each part of",
+                "the kernel's row timed alone on the same row and history (`bench.kernel._part_runs`),",
+                "us per row: the Kelvin update of every element (the A and B states, the damper work,",
+                "the losses and the memory peak; none at K = 0), the force (its memory integral) and",
+                "the edge search; `rest` is the batch row less those parts (extra substeps, retiming,",
+                "outputs, the Python of `step_depths` per call). `update / minimal`: the update alone",
+                "against the minimal stepper's whole row; where a part alone exceeds the target ratio,",
+                "the target is out of reach without dropping that part's work.",
+                "",
+            ]
+            rows = []
+            for item in parted:
+                parts = item["part_update_us"] + item["part_force_us"] + item["part_edge_us"]
+                rows.append(
+                    [
+                        str(item["elements"]),
+                        str(item["kelvin"]),
+                        _g(item["batch_us"]),
+                        _g(item["part_update_us"]),
+                        _g(item["part_force_us"]),
+                        _g(item["part_edge_us"]),
+                        _g(item["batch_us"] - parts),
+                        _g(item["substeps_per_step"]),
+                        _g(item["minimal_run_us"]),
+                        _g(item["part_update_us"] / item["minimal_run_us"]),
+                        _g(item["part_force_us"] / item["minimal_run_us"]),
+                    ]
+                )
+            header = [
+                "N",
+                "K",
+                "step_depths us",
+                "update us",
+                "force us",
+                "edge us",
+                "rest us",
+                "substeps",
+                "minimal run us",
+                "update / minimal",
+                "force / minimal",
+            ]
+            lines += _table(header, rows)
         lines += [
             "",
             "`substeps`: the kernel's adaptive substeps per 1 ms step; `in contact`: the fraction",
