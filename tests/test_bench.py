@@ -16,6 +16,7 @@ from viscoadh_ros.bench.latency import measure_round_trips, summarize_node_laten
 from viscoadh_ros.bench.timing import interleaved_medians, latency_summary
 from viscoadh_ros.cli.main import main as cli_main
 from viscoadh_ros.core import _kernels
+from viscoadh_ros.core.config import SceneConfig, default_scene_path
 from viscoadh_ros.core.simulator import ContactSimulator
 
 TINY = dataclasses.replace(
@@ -247,6 +248,46 @@ def test_step_costs_names_the_jump_rows_and_the_ratios() -> None:
     np.testing.assert_allclose(
         costs["force_mean_ratio"], costs["force_mean_us"] / costs["depth_mean_us"], rtol=1e-12
     )
+    # What the slowest row did: a depth step is one trial; every row runs the kernel at least
+    # once in contact; a force row searches (at least one trial).
+    assert costs["depth_median_trials"] == 1.0 and costs["depth_slowest_trials"] == 1
+    for name in ("depth", "force", "hold_pull"):
+        assert costs[f"{name}_slowest_trials"] >= 1 and costs[f"{name}_median_trials"] >= 1.0
+        assert 0 <= costs[f"{name}_slowest_row"] < (costs["hold_pull_rows"] if name == "hold_pull" else 1000)
+
+
+def test_row_work_counts_what_each_step_ran() -> None:
+    """`kernel._row_work` (the bound section's cause column): a depth row is one trial, with
+    no kernel substep while the indenter stays above an idle surface (after the first row's
+    look for a touch) and at least one once it presses; a force row counts every depth its
+    search tried (each a call of the model)."""
+    contact = SceneConfig.from_yaml(default_scene_path()).contacts[0]
+    times = kernel.STEP_S * np.arange(1, 41)
+    depths = np.where(np.arange(40) < 20, -5e-6, 20e-6)
+    trials, substeps = kernel._row_work(contact, times, depths, "depth")
+    assert np.all(trials == 1)
+    assert np.all(substeps[1:20] == 0) and np.all(substeps[20:] >= 1)
+    forces = ContactSimulator(contact).step_depths(times, depths)["force"]
+    trials, substeps = kernel._row_work(contact, times, forces, "force")
+    calls: list[int] = []
+    row_now = [0]
+    sim = ContactSimulator(contact)
+    advance = None
+    for index in range(times.size):
+        row_now[0] = index
+        if sim._model is not advance:
+            model = sim._model
+            original = model.advance
+
+            def counted(*args, _original=original):
+                calls.append(row_now[0])
+                return _original(*args)
+
+            model.advance = counted
+            advance = model
+        sim.step(float(times[index]), force=float(forces[index]))
+    assert np.array_equal(trials, np.bincount(calls, minlength=times.size))
+    assert trials[20:].sum() > 20  # a force search tries more than one depth somewhere
 
 
 def test_accuracy_cases_use_the_closed_forms() -> None:

@@ -376,6 +376,37 @@ def _per_step(simulator: ContactSimulator, times, values, key: str) -> npt.NDArr
     return cost
 
 
+def _row_work(contact: Any, times, values, key: str) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.int64]]:
+    """What each `step` call did (the measured cause of a slow row): the model trials it ran
+    (force control searches the depth, one trial per depth tried; a depth step is one) and the
+    kernel substeps of those trials together, per row, on a fresh simulator. Counted through
+    the simulator's trial entry (`ContactSimulator._trial`) and the row's substep output."""
+    simulator = ContactSimulator(contact)
+    counted = [0, 0]
+    trial = simulator._trial
+
+    def substeps() -> int:
+        row = getattr(simulator._model, "row", None)
+        return int(row.out[_kernels.OUT_SUBSTEPS]) if row is not None else 0
+
+    def counting_trial(t: float, d: float) -> tuple[float, float, float]:
+        result = trial(t, d)
+        counted[0] += 1
+        counted[1] += substeps()
+        return result
+
+    simulator._trial = counting_trial  # type: ignore[method-assign]
+    trials = np.zeros(times.size, dtype=np.int64)
+    steps = np.zeros(times.size, dtype=np.int64)
+    for index in range(times.size):
+        counted[0] = counted[1] = 0
+        simulator.step(float(times[index]), **{key: float(values[index])})
+        if counted[0] == 0:  # the depth step's lean path: one trial, the kernel called directly
+            counted[0], counted[1] = 1, substeps()
+        trials[index], steps[index] = counted
+    return trials, steps
+
+
 #: The large-N bounded-step scene: what `numerics.tolerance` 1e-4 picks for a two-mode standard
 #: solid (8192 elements, `fast`'s step control; the outside tester's 0.5.0 case, whose first
 #: step from rest took 500-1000x the median): a 5 mm sphere pressed from rest at 1 mm/s (the
@@ -510,6 +541,24 @@ def step_costs(*, repeats: int, seconds: float = SCENE_SECONDS, large: bool = Tr
                 f"{name}_p99_us": float(np.percentile(cost, 99.0)) * 1e6,
                 f"{name}_max_us": float(np.max(cost)) * 1e6,
                 f"{name}_max_over_median": float(np.max(cost)) / median,
+            }
+        )
+    # The measured cause of a slow row: the trials and kernel substeps of the slowest row
+    # against the median row's.
+    for name, cost, key, values, at in (
+        ("depth", depth_cost, "depth", depths, times),
+        ("force", force_cost, "force", forces, times),
+        ("hold_pull", hold_cost, "force", hold_forces, hold_times),
+    ):
+        trials, substeps = _row_work(contact, at, values, key)
+        slowest = int(np.argmax(cost))
+        summary.update(
+            {
+                f"{name}_slowest_row": slowest,
+                f"{name}_slowest_trials": int(trials[slowest]),
+                f"{name}_slowest_substeps": int(substeps[slowest]),
+                f"{name}_median_trials": float(np.median(trials)),
+                f"{name}_median_substeps": float(np.median(substeps)),
             }
         )
     summary["snap_in_us"] = float(depth_cost[snap_in]) * 1e6

@@ -74,6 +74,18 @@ def _g(value: float) -> str:
     return f"{value:.3g}"
 
 
+def _row_work(costs: dict[str, Any], name: str) -> str:
+    """The slowest row of a bound-section run and what it did, against the median row
+    (results from before 0.7.0 lack the counts)."""
+    if f"{name}_slowest_trials" not in costs:
+        return "-"
+    return (
+        f"row {costs[f'{name}_slowest_row']}: {costs[f'{name}_slowest_trials']}, "
+        f"{costs[f'{name}_slowest_substeps']} ({_g(costs[f'{name}_median_trials'])}, "
+        f"{_g(costs[f'{name}_median_substeps'])})"
+    )
+
+
 def _median(values: list[float]) -> float:
     ordered = sorted(values)
     if not ordered:
@@ -401,12 +413,23 @@ def render_markdown(results: dict[str, Any], figure: Path | None, notes: str | N
                 _g(costs[f"{name}_max_us"]),
                 _g(costs[f"{name}_max_over_median"]),
                 _mark(costs[f"{name}_max_over_median"] <= bound),
+                _row_work(costs, name),
             ]
             for name in ("depth", "force", "hold_pull")
             if f"{name}_median_us" in costs
         ]
         lines += _table(
-            ["control", "median us", "mean us", "p99 us", "max us", "max / median", "target"], rows
+            [
+                "control",
+                "median us",
+                "mean us",
+                "p99 us",
+                "max us",
+                "max / median",
+                "target",
+                "slowest row: trials, substeps (median row)",
+            ],
+            rows,
         )
         lines += [
             "",
