@@ -146,7 +146,18 @@ def _part_runs(
 
     def run_force() -> None:
         _force_parts(
-            radius, depth, row.wsum, row.bsum, row.dx, row.g_c, row.gf, row.gint, row.df, row.e0, row.kap, buf
+            radius,
+            depth,
+            row.wsum,
+            row.bsum,
+            row.dx,
+            row.g_c,
+            row.gf,
+            row.gint_kernel,
+            row.df,
+            row.e0,
+            row.kap,
+            buf,
         )
 
     def run_edge() -> None:
