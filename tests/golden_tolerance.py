@@ -22,6 +22,12 @@ force reads it, so the energy dissipated alone moves, by the rounding of a sum o
 non-negative terms (~N eps of it; on the golden scenes at most 1.2e-15 of its column's largest
 value), far below `RELATIVE`; it stays non-negative and its running sum monotone.
 
+The 0.7.0 kernel sums the K = 2..4 losses in the same four lanes, and takes the force's memory
+integral in its sum form (a trapezoid of the nodal deviations and a weighted sum of B with the
+grid's weights, `_kernels._fill_force_weights`): the same integral to rounding, so the force and
+the work move by ~1e-15 of their largest values and the energy dissipated by ~1e-15 of it; the
+state, the edge and every code are unchanged (nothing in them reads the force or the losses).
+
 Force control (`FORCED_RELATIVE` = 1e-7): a force step stops anywhere inside its stop band
 (half the force tolerance, >= 1e-5 of the commanded force in every preset), so trials whose
 forces moved at the 1e-15 level may stop at another point of that band (two rows of one

@@ -1,6 +1,7 @@
 """The written-out K = 2, 3, 4 Kelvin update (0.5.0, `scripts/gen_kelvin_update.py`): the block in
 `_kernels.py` is the generator's output, and it computes the same bits as the general loop
-(`_update_range_k` with a runtime K) on random rows, contact and free elements, any range."""
+(`_update_range_k` with a runtime K) on random rows, contact and free elements, any range; the
+losses' sum (four lanes since 0.7.0, `_sum_losses`) to rounding."""
 
 from __future__ import annotations
 
@@ -64,5 +65,15 @@ def test_written_out_update_equals_the_general_loop_bit_for_bit(k: int) -> None:
             else:
                 total, peak = _kernels._update_range(*args, 0.25, 1e-9)
             results.append((wl, wb, wsum, bsum, diss, np.array([total, peak])))
-        for got, want in zip(*results, strict=True):
+        *state, sums = results[0]
+        *want_state, want_sums = results[1]
+        for got, want in zip(state, want_state, strict=True):
             assert got.tobytes() == want.tobytes(), (trial, lo, hi, n_in)
+        # The peak exactly (a maximum in any order); the losses' sum in four lanes since 0.7.0
+        # (`_sum_losses`, as K = 1's): rounded otherwise, by a few eps of it (non-negative terms).
+        assert sums[1] == want_sums[1]
+        assert abs(sums[0] - want_sums[0]) <= 4 * n * np.finfo(float).eps * want_sums[0], (
+            trial,
+            sums,
+            want_sums,
+        )
