@@ -71,13 +71,20 @@ def _rows_caller(advance_rows):
 
 
 def _with_kernels(module, run):
+    """`run` with the simulator module on `module`'s kernels, its per-call step entry
+    (`simulator._STEP`, bound once from the kernels of the first model built) included: left
+    bound to the first module, a later scene's `step()` calls ran that module's kernel on
+    another module's row buffers (0.7.0: their constant layouts differ), and the scenes built
+    after a `replay` scene started from a garbage state."""
+
     def wrapped():
-        saved = simulator_module._kernels
+        saved = simulator_module._kernels, simulator_module._STEP
         simulator_module._kernels = module
+        simulator_module._STEP = None
         try:
             return run()
         finally:
-            simulator_module._kernels = saved
+            simulator_module._kernels, simulator_module._STEP = saved
 
     return wrapped
 
