@@ -423,6 +423,22 @@ def test_merge_into_a_file_written_before_runs_existed() -> None:
     assert merged["command"] == "viscoadh bench", "a partial run leaves the header to the full one"
 
 
+def test_a_bound_run_replaces_the_files_bound_figures(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The `bound` section writes `step_costs`, not a key named after it: its run must still be
+    listed, or a merge keeps the file's old figures (0.5.0-0.6.0 did: BENCHMARKS.md showed a
+    bound section from 2026-11-22 under two later releases' notes)."""
+    monkeypatch.setattr(kernel, "step_costs", lambda repeats: {"rows": 7, "depth_max_over_median": 1.5})
+    new = suite.run(
+        suite.QUICK, sections=["bound"], soak_minutes=None, command="viscoadh bench", progress=print
+    )
+    assert set(new["runs"]) == {"bound"}
+    run = {"command": "viscoadh bench --soak 10.0", "date": "d0", "machine": "m", "quick": False}
+    old = {**run, "step_costs": {"rows": 3000, "depth_max_over_median": 19.5}, "runs": {"bound": run}}
+    merged = suite.merge(old, new)
+    assert merged["step_costs"] == {"rows": 7, "depth_max_over_median": 1.5}
+    assert merged["runs"]["bound"]["date"] == new["date"]
+
+
 def test_unreadable_json_stops_the_run_with_nothing_changed(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -231,7 +231,10 @@ def run(
         )
         results["soak"] = soak(minutes=soak_minutes, contacts=count, hand=hand)
     run_info = {key: results[key] for key in RUN_KEYS}
-    results["runs"] = {name: dict(run_info) for name in SECTION_KEYS if name in results}
+    # A section is known by its first results key (`bound` writes `step_costs`): 0.5.0-0.6.0
+    # looked for the section's name, so a `bound` run was never listed and `merge` kept the
+    # file's old `step_costs` (BENCHMARKS.md showed 2026-11-22's bound figures until 0.7.0).
+    results["runs"] = {name: dict(run_info) for name, keys in SECTION_KEYS.items() if keys[0] in results}
     return results
 
 
