@@ -101,6 +101,7 @@ def test_kernel_row_is_well_formed(kelvin: int) -> None:
     # Where a batch row goes: every part timed (no update without Kelvin elements).
     assert row["part_force_us"] > 0.0 and row["part_edge_us"] > 0.0
     assert (row["part_update_us"] > 0.0) == (kelvin > 0)
+    assert math.isfinite(row["call_overhead_us"]) and math.isfinite(row["minimal_call_overhead_us"])
 
 
 @pytest.mark.parametrize("kelvin", [1, 4])
@@ -253,7 +254,11 @@ def test_step_costs_names_the_jump_rows_and_the_ratios() -> None:
     assert costs["depth_median_trials"] == 1.0 and costs["depth_slowest_trials"] == 1
     for name in ("depth", "force", "hold_pull"):
         assert costs[f"{name}_slowest_trials"] >= 1 and costs[f"{name}_median_trials"] >= 1.0
+        shares = [costs[f"{name}_rows_{n}_trial{'' if n == 'one' else 's'}"] for n in ("one", "two", "more")]
+        assert sum(shares) == pytest.approx(1.0) and costs[f"{name}_p99_row_trials"] >= 1
         assert 0 <= costs[f"{name}_slowest_row"] < (costs["hold_pull_rows"] if name == "hold_pull" else 1000)
+    assert costs["depth_rows_one_trial"] == 1.0
+    assert large["max_row_substeps"] >= 1 and large["median_substeps"] >= 1.0
 
 
 def test_row_work_counts_what_each_step_ran() -> None:

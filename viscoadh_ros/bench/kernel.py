@@ -320,8 +320,27 @@ def measure_kernel(elements: int, kelvin: int, *, steps: int, repeats: int) -> d
         for index in range(1, step_count + 1):
             minimal.step(STEP_S, float(depth[index]))
 
+    # The same stretch in one batch call each: what a call costs beyond its row is the
+    # difference (the Python around the kernel and the compiled call, the journal).
+    call_times = batch_times[:step_count]
+    call_depths = depth[1 : step_count + 1]
+
+    def run_steps_batch() -> None:
+        simulator.restore(start)
+        simulator.step_depths(call_times, call_depths)
+
+    def run_minimal_steps_batch() -> None:
+        minimal.set_state(depth=d_start, radius=radius, memory=wl0)
+        minimal.run(STEP_S, call_depths)
+
     calls = interleaved_medians(
-        {"step": run_steps, "minimal_step": run_minimal_steps}, repeats=max(1, repeats // 2)
+        {
+            "step": run_steps,
+            "minimal_step": run_minimal_steps,
+            "step_batch": run_steps_batch,
+            "minimal_step_batch": run_minimal_steps_batch,
+        },
+        repeats=max(1, repeats // 2),
     )
     agreement = _agreement(contact, row, minimal, case.depth_scale)
     element_steps = row.elements * steps
@@ -353,6 +372,10 @@ def measure_kernel(elements: int, kelvin: int, *, steps: int, repeats: int) -> d
         "part_update_us": times.get("part_update", 0.0) / steps * 1e6,
         "part_force_us": times["part_force"] / steps * 1e6,
         "part_edge_us": times["part_edge"] / steps * 1e6,
+        # Per call beyond the row: `step()` less `step_depths` over the same stretch, and the
+        # same for the minimal stepper (its `step` less its `run`), us per call.
+        "call_overhead_us": (calls["step"] - calls["step_batch"]) / step_count * 1e6,
+        "minimal_call_overhead_us": (calls["minimal_step"] - calls["minimal_step_batch"]) / step_count * 1e6,
         **agreement,
     }
 
@@ -469,7 +492,10 @@ def large_scene_costs(*, repeats: int) -> dict[str, Any]:
     snap_in, pull_off = _jump_rows(radius)
     median = float(np.median(cost))
     worst = int(np.argmax(cost))
+    _, substeps = _row_work(contact, times, depths, "depth")
     return {
+        "max_row_substeps": int(substeps[worst]),
+        "median_substeps": float(np.median(substeps)),
         "elements": int(elements),
         "rows": int(times.size),
         "median_us": median * 1e6,
@@ -563,6 +589,9 @@ def step_costs(*, repeats: int, seconds: float = SCENE_SECONDS, large: bool = Tr
     ):
         trials, substeps = _row_work(contact, at, values, key)
         slowest = int(np.argmax(cost))
+        # The row at the 99th percentile of cost (what sets the p99) and the share of rows by
+        # their trials.
+        p99_row = int(np.argsort(cost, kind="stable")[min(cost.size - 1, int(0.99 * cost.size))])
         summary.update(
             {
                 f"{name}_slowest_row": slowest,
@@ -570,6 +599,11 @@ def step_costs(*, repeats: int, seconds: float = SCENE_SECONDS, large: bool = Tr
                 f"{name}_slowest_substeps": int(substeps[slowest]),
                 f"{name}_median_trials": float(np.median(trials)),
                 f"{name}_median_substeps": float(np.median(substeps)),
+                f"{name}_p99_row_trials": int(trials[p99_row]),
+                f"{name}_p99_row_substeps": int(substeps[p99_row]),
+                f"{name}_rows_one_trial": float(np.mean(trials == 1)),
+                f"{name}_rows_two_trials": float(np.mean(trials == 2)),
+                f"{name}_rows_more_trials": float(np.mean(trials >= 3)),
             }
         )
     summary["snap_in_us"] = float(depth_cost[snap_in]) * 1e6

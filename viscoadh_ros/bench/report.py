@@ -350,7 +350,11 @@ def render_markdown(results: dict[str, Any], figure: Path | None, notes: str | N
                 "the edge search; `rest` is the batch row less those parts (extra substeps, retiming,",
                 "outputs, the Python of `step_depths` per call). `update / minimal`: the update alone",
                 "against the minimal stepper's whole row; where a part alone exceeds the target ratio,",
-                "the target is out of reach without dropping that part's work.",
+                "the target is out of reach without dropping that part's work. `per call`: what a",
+                "`step()` call costs beyond its row (`step()` less `step_depths` over the same",
+                "stretch: the Python around the kernel, the compiled call, the journal), beside the",
+                "minimal stepper's (its `step` less its `run`): the cause of a missed per-call ratio",
+                "where the rows are within reach.",
                 "",
             ]
             rows = []
@@ -369,6 +373,8 @@ def render_markdown(results: dict[str, Any], figure: Path | None, notes: str | N
                         _g(item["minimal_run_us"]),
                         _g(item["part_update_us"] / item["minimal_run_us"]),
                         _g(item["part_force_us"] / item["minimal_run_us"]),
+                        _g(item.get("call_overhead_us", float("nan"))),
+                        _g(item.get("minimal_call_overhead_us", float("nan"))),
                     ]
                 )
             header = [
@@ -383,6 +389,8 @@ def render_markdown(results: dict[str, Any], figure: Path | None, notes: str | N
                 "minimal run us",
                 "update / minimal",
                 "force / minimal",
+                "per call us",
+                "minimal per call us",
             ]
             lines += _table(header, rows)
         lines += [
@@ -431,6 +439,16 @@ def render_markdown(results: dict[str, Any], figure: Path | None, notes: str | N
             ],
             rows,
         )
+        for name in ("force", "hold_pull"):
+            if f"{name}_rows_one_trial" in costs:
+                lines += [
+                    "",
+                    f"`{name}` rows by model trials: one {_g(100 * costs[f'{name}_rows_one_trial'])} %, two "
+                    f"{_g(100 * costs[f'{name}_rows_two_trials'])} %, three or more "
+                    f"{_g(100 * costs[f'{name}_rows_more_trials'])} %; the row at its p99 ran "
+                    f"{costs[f'{name}_p99_row_trials']} trials "
+                    f"({costs[f'{name}_p99_row_substeps']} substeps).",
+                ]
         lines += [
             "",
             f"Snap-in row {costs['snap_in_row']}: {_g(costs['snap_in_us'])} us; pull-off row "
@@ -457,7 +475,13 @@ def render_markdown(results: dict[str, Any], figure: Path | None, notes: str | N
                 f"{_g(large['median_us'])} us, largest row {large['max_row']} {_g(large['max_us'])} us = "
                 f"{_g(large['max_over_median'])}x {_mark(large['max_over_median'] <= bound)}; snap-in row "
                 f"{large['snap_in_row']} {_g(large['snap_in_over_median'])}x, pull-off row "
-                f"{large['pull_off_row']} {_g(large['pull_off_over_median'])}x the median.",
+                f"{large['pull_off_row']} {_g(large['pull_off_over_median'])}x the median"
+                + (
+                    f"; the largest row ran {large['max_row_substeps']} kernel substeps (the median row "
+                    f"{_g(large['median_substeps'])})."
+                    if "max_row_substeps" in large
+                    else "."
+                ),
                 "",
             ]
     if "accuracy" in results:
