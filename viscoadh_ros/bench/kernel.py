@@ -340,7 +340,7 @@ def measure_kernel(elements: int, kelvin: int, *, steps: int, repeats: int) -> d
             "step_batch": run_steps_batch,
             "minimal_step_batch": run_minimal_steps_batch,
         },
-        repeats=max(1, repeats // 2),
+        repeats=max(1, repeats),
     )
     agreement = _agreement(contact, row, minimal, case.depth_scale)
     element_steps = row.elements * steps
