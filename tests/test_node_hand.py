@@ -51,7 +51,9 @@ def _hand(stamp_ns: int, depths: list[float], ids: list[str] | None = None) -> H
 class _Client:
     """Publishes on hand/indentation and c*/indentation; collects hand/state, hand/events, c*/state."""
 
-    def __init__(self, context: Any, executor: Any, spin_until: Any, ids: list[str]) -> None:
+    def __init__(
+        self, context: Any, executor: Any, spin_until: Any, ids: list[str], server: ViscoadhNode
+    ) -> None:
         self.executor, self.spin_until = executor, spin_until
         self.node = Node("hand_client", context=context)
         executor.add_node(self.node)
@@ -75,6 +77,13 @@ class _Client:
                 self.hand.get_subscription_count() > 0
                 and self.node.count_publishers("hand/state") > 0
                 and all(p.get_subscription_count() > 0 for p in self.single.values())
+                # Discovery is not symmetric: our publisher seeing the node's subscription does
+                # not mean the node's (reliable, volatile) publishers see ours, and what they
+                # publish before they do is dropped. A client in another context lost the
+                # answer to its first hand command that way in CI (2026-11-24).
+                and server.hand.state_pub.get_subscription_count() > 0
+                and server.hand.events_pub.get_subscription_count() > 0
+                and all(server.contacts[i].state_pub.get_subscription_count() > 0 for i in ids)
             ),
             TIMEOUT,
         ), "the node's hand topics did not match"
@@ -121,7 +130,7 @@ def test_a_client_in_another_context_drives_16_contacts_by_the_hand_topic_as_16_
     executor = SingleThreadedExecutor(context=other)
     try:
         ids = list(node.contacts)
-        client = _Client(other, executor, spin_until, ids)
+        client = _Client(other, executor, spin_until, ids, node)
         references = _references(scene)
         forces, expected = [], []
         for tick in range(25):
@@ -154,7 +163,7 @@ def hand_setup(ros_context: Any, ros_executor: Any, spin_until: Any) -> tuple[Vi
     scene = _scene(3)
     node = _node(ros_context, scene)
     ros_executor.add_node(node)
-    client = _Client(ros_context, ros_executor, spin_until, list(node.contacts))
+    client = _Client(ros_context, ros_executor, spin_until, list(node.contacts), node)
     return node, client, scene
 
 
@@ -251,7 +260,7 @@ def test_the_log_holds_one_record_per_hand_command_and_state(
     scene.update({"log.enabled": True, "log.path": str(tmp_path / "hand.mcap")})
     node = _node(ros_context, scene)
     ros_executor.add_node(node)
-    client = _Client(ros_context, ros_executor, spin_until, list(node.contacts))
+    client = _Client(ros_context, ros_executor, spin_until, list(node.contacts), node)
     sent = [_hand(client.t0 + k * 1_000_000, [DEPTH * k / 3] * 4) for k in range(3)]
     states = [client.send(msg) for msg in sent]
     assert all(state is not None for state in states)
