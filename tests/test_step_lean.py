@@ -294,3 +294,109 @@ def test_the_one_call_step_equals_the_0_4_0_step(
         if state_new[11] is not None:
             assert state_new[11].elements == state_old[11].elements
             assert state_new[11].dx == state_old[11].dx
+
+
+def _force_history(contact, scale: float) -> tuple[np.ndarray, np.ndarray]:
+    """Forces a controller commands at 1 kHz: those of a press, hold, pull past the pull-off
+    and touch again under depth control (so the force path meets snap-in, creep at a held
+    force, the fold and the let-go), then pulled 1.3x further than the depth run pulled."""
+    t = 1e-3 * np.arange(1, 361)
+    depth = scale * np.concatenate(
+        [np.linspace(-0.05, 1.0, 90), np.full(60, 1.0), np.linspace(1.0, -0.4, 150), np.full(60, 0.3)]
+    )
+    force = ContactSimulator(contact).step_depths(t, depth)["force"]
+    return t, np.where(force < 0.0, 1.3 * force, force)
+
+
+@pytest.mark.parametrize("name", ["default", "two_kelvin", "growing", "standard_fast", "cone"])
+def test_the_lean_force_path_equals_the_general_path(name: str) -> None:
+    """`step(t, force=f)` (the lean force path where its predicted root holds, else the
+    general path) and `_step_transaction` (always the general path) give bit-equal outputs,
+    force memos and states over a force history with the snap-in, creep, fold and let-go,
+    float and numpy-float and int commands, and refused commands between them; the lean path
+    served most rows (else this compares the general path with itself), and some of them
+    handed a prediction that did not hold over to the general search."""
+    contact, scale = scenes()[name], depth_scale(name)
+    times, forces = _force_history(contact, scale)
+    lean, general = ContactSimulator(contact), ContactSimulator(contact)
+    general_calls, handovers, inside = [0], [0], [False]
+    transaction, search = lean._step_transaction, lean._search_force
+
+    def counted(*args):
+        general_calls[0] += 1
+        inside[0] = True
+        try:
+            return transaction(*args)
+        finally:
+            inside[0] = False
+
+    def searched(*args):
+        handovers[0] += not inside[0]  # a lean step whose prediction failed goes on searching
+        return search(*args)
+
+    lean._step_transaction = counted  # type: ignore[method-assign]
+    lean._search_force = searched  # type: ignore[method-assign]
+    in_contact_rows = np.zeros(times.size, dtype=bool)
+    for index, (t, f) in enumerate(zip(times.tolist(), forces.tolist(), strict=True)):
+        calls = [(t, f)]
+        if index % 37 == 5:
+            calls = [(t, math.nan), (t - 1.0, f), (t, f)]  # refused, refused, then the good one
+        elif index % 11 == 3:
+            calls = [(np.float64(t), np.float64(f))]
+        elif index % 53 == 7:
+            calls = [(t, int(f))]
+        for call_t, call_f in calls:
+            results = []
+            for step in (
+                lambda t=call_t, f=call_f: lean.step(t, force=f),
+                lambda t=call_t, f=call_f: general._step_transaction(t, None, f),
+            ):
+                try:
+                    results.append(step())
+                except ValueError as error:
+                    results.append(type(error).__name__ + str(error))
+            assert results[0] == results[1], (name, index, call_t, call_f)
+            assert _state(lean)[:11] == _state(general)[:11], (name, index)
+            assert _state(lean)[12] == _state(general)[12], (name, index)
+        in_contact_rows[index] = lean.in_contact
+    assert general.output.force == lean.output.force
+    # Calls that took the lean path: every call but those counted (the refused and int ones
+    # among them); most rows in contact must be such calls.
+    calls = times.size + 2 * len(range(5, times.size, 37))
+    lean_calls, in_contact = calls - general_calls[0], int(np.count_nonzero(in_contact_rows))
+    assert handovers[0] >= 1, "no lean step handed a failed prediction over to the search"
+    assert lean_calls >= 0.8 * in_contact, (
+        f"the lean force path served {lean_calls} of {in_contact} rows in contact"
+    )
+
+
+@pytest.mark.parametrize("where", ["output", "memo"])
+def test_an_interrupt_inside_the_lean_force_step_changes_nothing(
+    where: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Interrupted after its trials (the output record) or after it published (the force
+    memo), a lean force step leaves the state as before; the next steps equal a simulator
+    that was never interrupted."""
+    contact, scale = scenes()["default"], depth_scale("default")
+    times, forces = _force_history(contact, scale)
+    sim, reference = ContactSimulator(contact), ContactSimulator(contact)
+    for k in range(100):
+        sim.step(float(times[k]), force=float(forces[k]))
+        reference.step(float(times[k]), force=float(forces[k]))
+    assert sim.in_contact and isinstance(sim._force_memo, tuple)
+    before = _state(sim)
+    if where == "output":
+        monkeypatch.setattr(simulator, "_object_new", lambda *args: (_ for _ in ()).throw(_Interrupt()))
+    else:
+        monkeypatch.setattr(
+            ContactSimulator, "_remember", lambda *args, **kwargs: (_ for _ in ()).throw(_Interrupt())
+        )
+    with pytest.raises(_Interrupt):
+        sim.step(float(times[100]), force=float(forces[100]))
+    assert _state(sim) == before
+    monkeypatch.undo()
+    for k in range(100, 140):
+        assert sim.step(float(times[k]), force=float(forces[k])) == reference.step(
+            float(times[k]), force=float(forces[k])
+        )
+    assert _state(sim)[12] == _state(reference)[12]

@@ -32,6 +32,7 @@ from viscoadh_ros.bench.accuracy import Case, cases, contact_config
 from viscoadh_ros.bench.reference_stepper import MinimalStepper
 from viscoadh_ros.bench.timing import interleaved_medians
 from viscoadh_ros.core import _kernels
+from viscoadh_ros.core import simulator as simulator_module
 from viscoadh_ros.core.config import SceneConfig, default_scene_path
 from viscoadh_ros.core.simulator import ContactSimulator
 
@@ -413,31 +414,31 @@ def _per_step(simulator: ContactSimulator, times, values, key: str) -> npt.NDArr
 def _row_work(contact: Any, times, values, key: str) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.int64]]:
     """What each `step` call did (the measured cause of a slow row): the model trials it ran
     (force control searches the depth, one trial per depth tried; a depth step is one) and the
-    kernel substeps of those trials together, per row, on a fresh simulator. Counted through
-    the simulator's trial entry (`ContactSimulator._trial`) and the row's substep output."""
-    simulator = ContactSimulator(contact)
+    kernel substeps of those trials together, per row, on a fresh simulator. Counted at the
+    compiled step every path calls (`simulator._STEP`: the lean depth and force paths and
+    `_TimeStepped.advance`): a trial is a kernel call that stepped (one that stopped for a
+    domain growth is not, its substeps count); a row with no call (idle above the surface) is
+    one trial of no substep."""
+    simulator = ContactSimulator(contact)  # loads the compiled step
     counted = [0, 0]
-    trial = simulator._trial
+    kernel_step = simulator_module._STEP
 
-    def substeps() -> int:
-        row = getattr(simulator._model, "row", None)
-        return int(row.out[_kernels.OUT_SUBSTEPS]) if row is not None else 0
-
-    def counting_trial(t: float, d: float) -> tuple[float, float, float]:
-        result = trial(t, d)
-        counted[0] += 1
-        counted[1] += substeps()
+    def counting_step(*args: Any) -> Any:
+        result = kernel_step(*args)
+        counted[0] += result[0] == _kernels.STATUS_OK
+        counted[1] += int(result[4])
         return result
 
-    simulator._trial = counting_trial  # type: ignore[method-assign]
     trials = np.zeros(times.size, dtype=np.int64)
     steps = np.zeros(times.size, dtype=np.int64)
-    for index in range(times.size):
-        counted[0] = counted[1] = 0
-        simulator.step(float(times[index]), **{key: float(values[index])})
-        if counted[0] == 0:  # the depth step's lean path: one trial, the kernel called directly
-            counted[0], counted[1] = 1, substeps()
-        trials[index], steps[index] = counted
+    simulator_module._STEP = counting_step
+    try:
+        for index in range(times.size):
+            counted[0] = counted[1] = 0
+            simulator.step(float(times[index]), **{key: float(values[index])})
+            trials[index], steps[index] = max(counted[0], 1), counted[1]
+    finally:
+        simulator_module._STEP = kernel_step
     return trials, steps
 
 

@@ -1629,7 +1629,192 @@ class ContactSimulator:
                     self._energy_input, self._time, self._depth = energy0, time0, d_prev
                     self._output, self._held_force = output0, held0
                     raise
+        elif depth is None and self._lean:
+            # The lean force path: a force step whose predicted root holds (85 % of the
+            # default scene's force rows) in one frame, else the general path below.
+            if type(force) is float and type(time) is float:
+                output = self._predicted_force_step(time, force)
+            elif isinstance(force, float) and isinstance(time, float):
+                output = self._predicted_force_step(float(time), float(force))
+            else:
+                output = None
+            if output is not None:
+                return output
         return self._step_transaction(time, depth, force)
+
+    def _predicted_force_step(self, t: float, target: float) -> StepOutput | None:
+        """`step(t, force=target)` when its predicted root holds: `_solve_force`'s first
+        branch (the path prediction and `_predicted_root`'s secant trials) with `_trial`,
+        `advance`, `rewind` and `_publish` in this one frame and the kernel deriving the
+        outputs (`_STEP`, as the lean depth path): the general path's trials, outputs, memo
+        and state bit for bit (tests/test_step_lean.py). None, with nothing changed, when
+        that branch does not apply or does not find the root (a trial detached, a slope
+        unlike the last, a step the domain cannot hold): the general path then runs the
+        step from the start (the same trials again, 0.2 % of the default scene's rows)."""
+        if not (t - t == 0.0 and target - target == 0.0 and t >= self._time):
+            return None  # the general path says what is wrong
+        before = self._output
+        memo = self._force_memo
+        r_before = before.contact_radius
+        if not (type(memo) is tuple and memo[0] is before and r_before > 0.0):
+            return None
+        physics = self.physics
+        glass = 2.0 * physics.e0 * r_before
+        slope = memo[1]
+        model = self._model
+        row = model.row
+        if not (
+            slope >= FOLD_SLOPE * glass
+            and row is not None
+            and getattr(model.advance, "__code__", None) is _ADVANCE_CODE
+        ):
+            return None
+        time0 = self._time
+        d0 = self._depth
+        f0 = before.force
+        dt = t - time0
+        stop = self._force_stop(target, r_before)
+        first = _path_prediction(memo[4], t, target, slope)
+        if first is None:
+            # F(d) ~ F(d0) + slope (d - d0), F(d0) ~ f0 + drift_rate dt.
+            first = d0 + (target - f0 - memo[2] * dt) / slope
+        bend = memo[3]
+        state, const = row.addresses
+        max_substep, max_edge_cells = model._max_substep, model._max_edge_cells
+        e_relaxed, v_c1, v_c2 = self._e_relaxed, self._v_c1, self._v_c2
+        token = model.begin()
+        start = model.trial_start()
+        radius0, dissipated0 = model.radius, model.dissipated
+        # `advance`'s rule for the force known at the start (the first trial only: a rewind
+        # forgets it).
+        known = model._force_at
+        if known is not None and known[0] is row and known[1] == radius0 and known[2] == d0 and d0 != 0.0:
+            force_prev = known[3]
+        else:
+            force_prev = math.nan
+        trials: list[tuple[float, float, float]] = []
+        energy0 = self._energy_input
+        try:
+            x = first
+            r = tangent = 0.0
+            shrunk = False
+            result = None
+            grow = False
+            last: list[Any] = [None, None]
+            for trial in range(1, self.PREDICTED_TRIALS_CONVERGING + 1):
+                if trial > 1:
+                    # `residual`'s rewind (`rewind` of `trial_start`): the memory back from
+                    # the journal the last trial wrote, which the next one writes again.
+                    if trial > self.PREDICTED_TRIALS and not shrunk:
+                        break
+                    x_new = x - r / tangent
+                    if x_new == x or abs(x_new - x) * FOLD_SLOPE * glass > abs(r):
+                        break
+                    _kernels._restore_state(row.wl, row.wsum, row.wb, row.bsum, row.txn, row.txn_b)
+                    model.radius = radius0
+                    model.dissipated = dissipated0
+                else:
+                    x_new = x
+                model._force_at = None
+                model._journal = row
+                result = _STEP(
+                    state,
+                    const,
+                    True,
+                    radius0,
+                    d0,
+                    x_new,
+                    dt,
+                    max_substep,
+                    max_edge_cells,
+                    force_prev,
+                    r_before,
+                    e_relaxed,
+                    v_c1,
+                    v_c2,
+                )
+                force_prev = math.nan
+                if result[0] != 0:  # not _kernels.STATUS_OK: the domain must grow
+                    result = None
+                    grow = True
+                    break
+                radius, f = result[1], result[2]
+                # `advance`'s bookkeeping after its kernel call.
+                model.radius = radius
+                model.substeps = result[4]
+                model.dissipated = dissipated0 + result[5]
+                model._memory_peak = result[6]
+                model._edge = result[7]
+                model._edge_depth = x_new
+                model._force_at = (row, radius, x_new, f)
+                if row is not model._prepare_row:
+                    model._prepare_row = row
+                    model._prepare_radius = PREPARE_FRACTION * row.length
+                elif radius > model._prepare_radius:
+                    model._prepare_growth(row)
+                trials.append((x_new, f, radius))
+                last = [x_new, (radius, f, result[3])]
+                r_new = f - target
+                if not radius > 0.0:
+                    result = None
+                    break
+                if trial == 1:
+                    tangent = slope + bend * (first - d0)
+                    if not 0.5 * slope < tangent < 2.0 * slope:
+                        tangent = slope
+                    shrunk = False
+                else:
+                    secant = (r_new - r) / (x_new - x)
+                    if not 0.25 * slope <= secant <= 4.0 * slope:
+                        result = None
+                        break
+                    shrunk = abs(r_new) <= 0.01 * abs(r)
+                    tangent = secant
+                x, r = x_new, r_new
+                if abs(r) <= stop:
+                    break
+            else:
+                result = None
+            if grow:
+                # A trial the domain cannot hold: nothing of this attempt stays; the general
+                # path runs the step (`advance` grows the domain inside the trial).
+                model.rollback(token)
+                return None
+            if result is None or not abs(r) <= stop:
+                # The prediction did not hold: on to the general search as `_solve_force`
+                # goes on after `_predicted_root`, from the same trials (its next trial
+                # rewinds the model from the journal).
+                trials.clear()
+                output = self._search_force(t, target, start, last, trials)
+                self._held_force = target
+                return output
+            # `_publish` of the trial at the root (the model is in its state).
+            energy = energy0 + result[3]
+            output = _object_new(StepOutput)
+            values = output.__dict__
+            values["time"] = t
+            values["depth"] = x
+            values["force"] = result[2]
+            values["contact_radius"] = result[1]
+            values["phase"] = _PHASES[result[8]]
+            values["edge_speed"] = result[9]
+            values["effective_work_of_adhesion"] = result[10]
+            values["energy_input"] = energy
+            values["energy_dissipated"] = model.dissipated
+            values["scale_separation_ok"] = result[11]
+            values["unstable"] = False
+            self._energy_input = energy
+            self._time = t
+            self._depth = x
+            self._output = output
+            self._remember(output, before, trials, d0, f0, dt, None, slope)
+            self._held_force = target
+            return output
+        except BaseException:
+            model.rollback(token)
+            self._energy_input, self._time, self._depth = energy0, time0, d0
+            self._output, self._force_memo = before, memo
+            raise
 
     def _step_transaction(self, time: float, depth: float | None, force: float | None) -> StepOutput:
         """`step` on the general path: validation, then `_step` as a transaction."""
@@ -1873,27 +2058,16 @@ class ContactSimulator:
         before = self._output
         f0 = before.force
         dt = time - self._time
-        tol = self.numerics.force_tolerance * max(abs(target), abs(f0), 1e-300)
         stop = self._force_stop(target, self._output.contact_radius)
-        was_in_contact = self.in_contact
-
         last: list[Any] = [None, None]  # depth of the last trial and its (radius, force, work)
         trials: list[tuple[float, float, float]] = []  # (depth, force, radius) of every trial
-
-        def residual(depth: float) -> float:
-            if last[0] is not None:
-                model.rewind(start)
-            result = self._trial(time, depth)
-            last[0], last[1] = depth, result
-            trials.append((depth, result[1], result[0]))
-            return result[1] - target
-
+        residual = self._residual(time, target, start, last, trials)
         memo = self._force_memo
         glass = 2.0 * self.physics.e0 * before.contact_radius
         if (
             isinstance(memo, tuple)
             and memo[0] is self._output
-            and was_in_contact
+            and self.in_contact
             and memo[1] >= FOLD_SLOPE * glass
         ):
             slope, drift_rate, bend = memo[1], memo[2], memo[3]
@@ -1908,7 +2082,53 @@ class ContactSimulator:
                 self._remember(output, before, trials, d0, f0, dt, None, slope)
                 return output
             trials.clear()
+        return self._search_force(time, target, start, last, trials)
 
+    def _residual(
+        self,
+        time: float,
+        target: float,
+        start: Any,
+        last: list[Any],
+        trials: list[tuple[float, float, float]],
+    ):
+        """The force search's residual F(depth) - target (N) at `time` (s): one trial of the
+        model from `start` (the model's state before the step, rewound to before every trial
+        but the first), kept in `last` (its depth and (radius, force, work)) and appended to
+        `trials` as (depth, force, radius)."""
+        model = self._model
+
+        def residual(depth: float) -> float:
+            if last[0] is not None:
+                model.rewind(start)
+            result = self._trial(time, depth)
+            last[0], last[1] = depth, result
+            trials.append((depth, result[1], result[0]))
+            return result[1] - target
+
+        return residual
+
+    def _search_force(
+        self,
+        time: float,
+        target: float,
+        start: Any,
+        last: list[Any],
+        trials: list[tuple[float, float, float]],
+    ) -> StepOutput:
+        """`_solve_force` after its predicted root (none, or it did not hold): the search from
+        rest or the bracketing search from the held depth. `start`: the model's state before
+        the step; `last`: the last trial (depth None when none ran yet) or the failed
+        prediction's; `trials`: empty."""
+        model = self._model
+        d0 = self._depth
+        before = self._output
+        f0 = before.force
+        tol = self.numerics.force_tolerance * max(abs(target), abs(f0), 1e-300)
+        stop = self._force_stop(target, before.contact_radius)
+        was_in_contact = self.in_contact
+        memo = self._force_memo
+        residual = self._residual(time, target, start, last, trials)
         cold = self._from_rest(residual, d0, target, stop) if not was_in_contact else None
         if cold is not None:
             lo, r_lo, hi, r_hi, stop = cold
