@@ -106,3 +106,39 @@ def test_a_simulator_listed_twice_is_refused() -> None:
     with pytest.raises(InputError, match="each simulator once"):
         step_contacts([sims[0], sims[1], sims[0]], [0.0] * 3, DEPTH, [1e-5] * 3)
     assert all(s.time == 0.0 and not s.in_contact for s in sims)
+
+
+def test_contacts_on_the_lean_force_path_are_undone_too() -> None:
+    """Contacts held under force control take the lean force step (one frame, the predicted
+    root); when a later contact of the sample fails, they are undone from that step's journal
+    bit for bit and go on like contacts that never saw the sample."""
+    sims, alone = _simulators(3), _simulators(3)
+    forces = [2e-3, 1e-3, 5e-4]
+    for k in range(1, 13):
+        t, scale = k * 1e-3, 0.5 + 0.05 * k
+        values = [scale * f for f in forces]
+        step_contacts(sims, [t] * 3, FORCE, values)
+        for s, v in zip(alone, values, strict=True):
+            s.step(t, force=v)
+    before = [_full_state(s) for s in sims]
+    general = [0]
+    for s in sims:
+        transaction = s._step_transaction
+
+        def counted(*args, _transaction=transaction):
+            general[0] += 1
+            return _transaction(*args)
+
+        s._step_transaction = counted  # type: ignore[method-assign]
+    with pytest.raises(ContactStepError) as raised:
+        step_contacts(sims, [13e-3, 13e-3, 5e-3], FORCE, [1.2 * f for f in forces])
+    assert raised.value.index == 2
+    # The first two took the lean path (only the failing one's refusal went the general way).
+    assert general[0] == 1
+    assert [_full_state(s) for s in sims] == before
+    for k in range(13, 20):
+        t, values = k * 1e-3, [(1.8 - 0.05 * k) * f for f in forces]
+        assert step_contacts(sims, [t] * 3, FORCE, values) == [
+            s.step(t, force=v) for s, v in zip(alone, values, strict=True)
+        ]
+    assert [_full_state(s)[8] for s in sims] == [_full_state(s)[8] for s in alone]
