@@ -39,7 +39,7 @@ class _Counting(ContactSimulator):
 class _Unpredicted(_Counting):
     """The reference: no bracket predicted from the last pull-off."""
 
-    def _predicted_detachment(self, residual, trials, d0, shift, target, stop):
+    def _predicted_detachment(self, residual, trials, d0, shift, target):
         return None
 
 
@@ -119,3 +119,35 @@ def test_a_push_back_in_after_a_pull_off_meets_its_target() -> None:
     for out, target in zip(outputs[touch:], forces[touch:], strict=True):
         assert out.contact_radius > 0.0
         assert abs(out.force - target) <= tolerance * target, out
+
+
+def test_a_hard_pull_lets_go_where_a_gentle_one_does() -> None:
+    """Pulled from a pressed contact with forces no attached depth reaches, from 3x its
+    adhesive force to -1e308 N, the contact lets go at the same depth (the detachment
+    bisected to the tolerance of where it holds, not of the force pulled or of the far
+    detached trial), every output finite, and it can be pushed back in. Before 0.8.0, -1e100 N
+    published a depth of -1e71 m and an energy of 1e136 J (-1e200 N: NaN), after which a push
+    was refused as beyond the domain, and the let-go depth moved with the force (-1.23 um at
+    -1 N, -4.7 um at -1e6 N)."""
+    contact = default_contact()
+    pulls = (-0.05, -1.0, -1e3, -1e6, -1e100, -1e200, -1e308)
+    outputs, pushed = [], []
+    held = 0.0
+    for pull in pulls:
+        sim = ContactSimulator(contact)
+        sim.step(1e-3, force=0.02)
+        held = sim.step(2e-3, force=0.02).depth
+        out = sim.step(3e-3, force=pull)
+        outputs.append(out)
+        pushed.append(sim.step(4e-3, force=0.02))
+    tolerance = ContactSimulator(contact).numerics.force_tolerance
+    depth = outputs[0].depth
+    for pull, out, back in zip(pulls, outputs, pushed, strict=True):
+        assert out.contact_radius == 0.0 and out.unstable and out.force == 0.0, pull
+        values = [
+            getattr(out, name) for name in out.__dataclass_fields__ if isinstance(getattr(out, name), float)
+        ]
+        assert all(np.isfinite(values)), (pull, out)
+        # Bisected to half the tolerance of the held depth: within its whole tolerance.
+        assert abs(out.depth - depth) <= tolerance * abs(held), (pull, out.depth, depth)
+        assert back.contact_radius > 0.0 and abs(back.force - 0.02) <= 2.0 * tolerance * 0.02, (pull, back)

@@ -2163,6 +2163,14 @@ class ContactSimulator:
             # overshot the root 3x into a deep, dear trial (57 substeps, a third of the step).
             stiffness *= self.physics.e0 / self.physics.e_relaxed
         delta = max(abs(r_hold) / stiffness, 1e-12 * (abs(d0) + 1e-12))
+        row = getattr(model, "row", None)
+        if direction < 0.0 and row is not None:
+            # A pull needs no trial farther above the held depth than the domain is long:
+            # the contact lets go well before (its adhesive neck and the memory's depression
+            # are a fraction of the contact radius, which the domain exceeds). The Newton step
+            # of an absurd pull (-1e100 N over the stiffness) went to -1e71 m and published
+            # that depth, non-finite energies and a contact that could not be pushed back.
+            delta = min(delta, row.length)
         lo, r_lo = d0, r_hold
         # Pulled to a zero force, an adhesive contact holds it before it lets go; a detached
         # trial (zero force too) is no root then: look for the attached one.
@@ -2172,7 +2180,7 @@ class ContactSimulator:
         if isinstance(memo, _PullOff) and memo.output is before and direction < 0.0 and self._attached():
             # The last step pulled off and the held depth touched again: a bracket of the
             # detachment around the depth the last step's shift predicts.
-            probed = self._predicted_detachment(residual, trials, d0, memo.shift, target, stop)
+            probed = self._predicted_detachment(residual, trials, d0, memo.shift, target)
         if probed is not None:
             found, boundary = probed
             if found is None:
@@ -2186,7 +2194,7 @@ class ContactSimulator:
                 break
             if detached:
                 found, boundary = self._search_dip(
-                    residual, trials, target, stop, golden_section=not dip_searched
+                    residual, trials, target, golden_section=not dip_searched
                 )
                 if found is None:
                     return self._pulled_off(boundary, time, start, last)
@@ -2199,7 +2207,7 @@ class ContactSimulator:
                 # over many cells); the same golden section, between the same neighbours of
                 # the smallest trial. None found: on to the detachment as before.
                 dip_searched = True
-                found, _ = self._search_dip(residual, trials, target, stop, detachment=False)
+                found, _ = self._search_dip(residual, trials, target, detachment=False)
                 if found is not None:
                     lo, r_lo, hi, r_hi = found
                     break
@@ -2400,7 +2408,6 @@ class ContactSimulator:
         residual,
         trials: list[tuple[float, float, float]],
         target: float,
-        stop: float,
         *,
         golden_section: bool = True,
         detachment: bool = True,
@@ -2416,8 +2423,11 @@ class ContactSimulator:
         smallest attached trial, a detached point counting as above everything, and given up
         once the smallest attached force found is above the target by more than the force can
         drop within the bracket; only then is the detachment depth bisected, to 1e-13
-        relative or to where the force cannot move by more than `stop` (N) across the
-        interval. Both use the Lipschitz bound 2 x the glass stiffness 2 E0* a of the largest
+        relative, to half the force tolerance of the depths where the contact holds, or to
+        where the force cannot move by more than half the force tolerance of the largest
+        attached force across the interval (0.8.0: not of the target, which no attached
+        depth reaches, nor of the detached end's depth: a hard pull moved the published
+        depth). Both use the Lipschitz bound 2 x the glass stiffness 2 E0* a of the largest
         contact tried (F(d) moves no faster under an instantaneous change of depth).
 
         `golden_section=False` skips the first part (a search before found no dip around
@@ -2483,9 +2493,17 @@ class ContactSimulator:
         lo = max((d for d, _, r in trials if r <= 0.0 and d < hi), default=math.nan)
         if not (math.isfinite(lo) and math.isfinite(hi)):
             return None, min(d for d, _, r in trials if r <= 0.0)
+        # The width is relative to where the contact holds: the depths of the shallowest
+        # attached trial and of the held depth (not the detached end, which a hard pull puts
+        # far away) and the largest attached force (not the target, which no attached depth
+        # reaches). Relative to the pull, the depth published after a pull-off moved with the
+        # force pulled (-1.23 um at -1 N, -1.31 um at -1000 N, -4.7 um at -1e6 N on the
+        # default scene, where it lets go at -1.22 um).
+        tolerance = self.numerics.force_tolerance
+        held = max((abs(f) for _, f, r in trials if r > 0.0), default=0.0)
         width = max(
-            stop / lipschitz if lipschitz > 0.0 else 0.0,
-            0.5 * self.numerics.force_tolerance * max(abs(hi), abs(lo)),
+            0.5 * tolerance * held / lipschitz if lipschitz > 0.0 else 0.0,
+            0.5 * tolerance * max(abs(hi), abs(self._depth)),
         )
         for _ in range(60):
             if hi - lo <= max(1e-13 * max(abs(hi), abs(lo), 1e-300), width):
@@ -2539,7 +2557,6 @@ class ContactSimulator:
         d0: float,
         shift: float,
         target: float,
-        stop: float,
     ) -> tuple[tuple[float, float, float, float] | None, float] | None:
         """A pull after a pull-off whose held depth `d0` (m) touched again as the surface crept
         back: the contact lets go about as far below the held depth as in the last step
@@ -2572,5 +2589,5 @@ class ContactSimulator:
             if attached and r <= 0.0:
                 return None
             if attached != held:
-                return self._search_dip(residual, trials, target, stop, bounded=True)
+                return self._search_dip(residual, trials, target, bounded=True)
         return None
