@@ -245,3 +245,95 @@ def test_pull_off_converges_with_refinement(work: float) -> None:
     case = f"w={work} errors={np.round(errors, 5).tolist()}"
     assert errors[-1] < 0.5 * errors[0], f"{case}: no convergence with refinement"
     assert errors[-1] < 1e-2, f"{case}: not within 1% at 256 elements"
+
+
+def _frozen(sim: ContactSimulator) -> tuple:
+    """What a refused step must leave as it was: outputs, memo and the memory's bits."""
+    row = getattr(sim._model, "row", None)
+    memory = b"" if row is None else row.wl.tobytes() + row.wb.tobytes() + row.wsum.tobytes()
+    return (sim.time, sim.output, sim._energy_input, sim._held_force, sim._force_memo, memory)
+
+
+def _standard_solid() -> Any:
+    return one_contact({"shape": "sphere", "radius": 0.005}, kelvin=[1e5], viscosities=[1.1e4], work=0.05)
+
+
+def _punch() -> Any:
+    return one_contact(
+        {"shape": "flat_punch", "radius": 5e-4},
+        kelvin=[1e5],
+        viscosities=[1e4],
+        work=0.05,
+        numerics={"preset": "fast"},
+    )
+
+
+@pytest.mark.parametrize(
+    "bad",
+    [
+        # Text and booleans are not numbers, though float() takes them (outside tester, 0.8.0).
+        {"time": 2e-3, "force": "0.001"},
+        {"time": 2e-3, "force": b"0.001"},
+        {"time": 2e-3, "force": True},
+        {"time": "2e-3", "depth": 1e-5},
+        {"time": 2e-3, "depth": np.bool_(True)},
+        # A time step the substep control halved to zero (ZeroDivisionError before 0.8.0):
+        # only near time 0 can a step be that short.
+        {"time": 1e-310, "force": 0.001},
+        {"time": 1e-310, "depth": 1e-5},
+    ],
+)
+def test_a_refused_command_changes_nothing_and_the_next_one_steps(bad: dict[str, Any]) -> None:
+    """Bad input, on the lean and the general paths alike: an InputError (a ValueError) that
+    says what is wrong, the state as before, and the next good command steps as if the bad one
+    never came."""
+    from viscoadh_ros.core.errors import InputError
+
+    contact = _standard_solid()
+    sim, reference_sim = ContactSimulator(contact), ContactSimulator(contact)
+    for force in (1e-3, 1.2e-3, 1.1e-3):  # jumps at time 0
+        sim.step(0.0, force=force)
+        reference_sim.step(0.0, force=force)
+    before = _frozen(sim)
+    time = bad.pop("time")
+    with pytest.raises(InputError, match="must be a number|shorter than the shortest"):
+        sim.step(time, **bad)
+    assert _frozen(sim) == before
+    for k in range(4, 8):
+        assert sim.step(k * 1e-3 / 3, force=1.5e-3) == reference_sim.step(k * 1e-3 / 3, force=1.5e-3)
+
+
+def test_a_time_step_below_the_shortest_is_refused_by_step_depths_too() -> None:
+    from viscoadh_ros.core.errors import InputError
+    from viscoadh_ros.core.simulator import MIN_TIME_STEP
+
+    sim = ContactSimulator(_standard_solid())
+    sim.step(0.0, depth=1e-5)
+    before = _frozen(sim)
+    times = np.array([0.0, 1e-310, 3e-3])
+    with pytest.raises(InputError, match=r"time\[1\].*shorter than the shortest"):
+        sim.step_depths(times, np.full(3, 1e-5))
+    assert _frozen(sim) == before
+    # At the shortest step and at a repeated time (a jump) it steps.
+    out = sim.step_depths(np.array([0.0, MIN_TIME_STEP, 2.0 * MIN_TIME_STEP]), np.array([1e-5, 2e-5, 2e-5]))
+    assert np.all(np.isfinite(out["energy_input"])) and np.all(np.isfinite(out["edge_speed"]))
+
+
+@pytest.mark.parametrize("control", ["force", "depth"])
+def test_a_push_whose_energy_overflows_is_refused(control: str) -> None:
+    """A flat punch's contact radius is fixed, so no domain limit refuses an absurd push:
+    1e154 N (or the depth it reaches) overflowed the energies to inf and the step was taken
+    (outside tester, 0.8.0). Such a step is refused and changes nothing; a finite one is kept."""
+    from viscoadh_ros.core.errors import InputError
+
+    sim = ContactSimulator(_punch())
+    sim.step(1e-3, force=1e-3)
+    before = _frozen(sim)
+    with pytest.raises(InputError, match="energy is not finite"):
+        sim.step(2e-3, **{control: 1e200})
+    assert _frozen(sim) == before
+    with pytest.raises(InputError, match="energy is not finite"):
+        sim.step_depths(np.array([2e-3]), np.array([1e200]))
+    assert _frozen(sim) == before
+    out = sim.step(2e-3, force=2e-3)
+    assert all(math.isfinite(getattr(out, name)) for name in FIELDS)

@@ -22,7 +22,10 @@ class InputError(ValueError):
 
 def require_finite(name: str, value: float) -> float:
     """Return ``value`` as a float, or raise :class:`InputError` naming ``name`` if it is
-    not a finite real number."""
+    not a finite real number. Text (``"0.01"``, ``b"0.01"``) and booleans are not numbers
+    here, though ``float`` takes them."""
+    if isinstance(value, (str, bytes, bytearray, bool, numpy.bool_)):
+        raise InputError(f"{name} must be a number (got {value!r})")
     try:
         number = float(value)
     except (TypeError, ValueError):

@@ -807,12 +807,7 @@ class _TimeStepped:
         journal = self._journal is not row
         start = None if journal else self.get_state()
         radius0, dissipated0 = self.radius, self.dissipated
-        known = self._force_at
-        # A signed zero depth could give the force another sign of zero: integrate it then.
-        if known is not None and known[0] is row and known[1] == radius0 and known[2] == d0 and d0 != 0.0:
-            force_prev = known[3]
-        else:
-            force_prev = math.nan
+        force_prev = self._start_force(row, d0)
         self._force_at = None
         while True:
             row = self.row
@@ -849,21 +844,35 @@ class _TimeStepped:
             self.radius, self.dissipated = radius0, dissipated0
             self._grow(d0)
             start = self.get_state()
-        _, radius, force, work, substeps, dissipated, peak, edge = result[:8]
+        self._stepped(row, result, d1, dissipated0)
+        return result[1], result[2], result[3]
+
+    def _start_force(self, row: _kernels.Row, d0: float) -> float:
+        """The force at the start of a step from depth `d0` (m) on `row`, N, when the last
+        kernel call ended there (same row, radius and depth), else NaN: the kernel integrates
+        it. A signed zero depth could give the force another sign of zero: integrated then."""
+        known = self._force_at
+        if known is not None and known[0] is row and known[1] == self.radius and known[2] == d0 and d0 != 0.0:
+            return known[3]
+        return math.nan
+
+    def _stepped(self, row: _kernels.Row, result: tuple, d1: float, dissipated0: float) -> None:
+        """The model's fields after a kernel call on `row` that stepped to depth `d1` (m):
+        `result` is `_STEP`'s tuple, `dissipated0` the energy dissipated before the call (J)."""
+        radius = result[1]
         self.radius = radius
-        self.substeps = substeps
-        self.dissipated += dissipated
-        self._memory_peak = peak
-        self._edge = edge
+        self.substeps = result[4]
+        self.dissipated = dissipated0 + result[5]
+        self._memory_peak = result[6]
+        self._edge = result[7]
         self._edge_depth = d1
-        self._force_at = (row, radius, d1, force)
+        self._force_at = (row, radius, d1, result[2])
         if row is not self._prepare_row:
             # A new row (a growth in this step: its next domain is prepared from the next step).
             self._prepare_row = row
             self._prepare_radius = PREPARE_FRACTION * row.length
         elif radius > self._prepare_radius:
             self._prepare_growth(row)
-        return radius, force, work
 
     def advance_rows(
         self, sim: ContactSimulator, times: np.ndarray, depths: np.ndarray
@@ -1142,6 +1151,20 @@ def _phase(model: Any, physics: _Physics, depth: float, r0: float, radius: float
 #: dF/dd is below this fraction of the glass stiffness 2 E0* a (near the fold of F(d); away
 #: from it a step's slope is 0.46 to 1 times the glass stiffness on the bench's history).
 FOLD_SLOPE = 0.3
+
+#: The shortest time step (s) a step takes; a shorter one (other than none: a jump at one
+#: time) is refused. Below it the substep control halved steps to zero (a ZeroDivisionError
+#: at 6e-322 s) and an edge speed overflowed.
+MIN_TIME_STEP = 1e-300
+
+
+def _overflow(energy_input: float, energy_dissipated: float) -> InputError:
+    """The error of a step whose energy overflowed (a force or depth far beyond what the
+    scene represents, e.g. 1e154 N on a flat punch, which no domain limit refuses)."""
+    return InputError(
+        f"the step's energy is not finite (energy input {energy_input!r} J, dissipated "
+        f"{energy_dissipated!r} J): the force or depth is far beyond the scene's range"
+    )
 #: Converged force steps in a row the force search's first trial extrapolates its depth from.
 PATH_POINTS = 4
 
@@ -1434,6 +1457,11 @@ class ContactSimulator:
         t = require_finite("time", time)
         if t < self._time:
             raise InputError(f"time must not go backwards (got {t!r} after {self._time!r})")
+        if 0.0 < t - self._time < MIN_TIME_STEP:
+            raise InputError(
+                f"time step {t - self._time!r} s is shorter than the shortest the model takes "
+                f"({MIN_TIME_STEP!r} s): repeat the last time for a jump, or step further"
+            )
         return t
 
     # Every public stepping call is a transaction: on any exception (bad input, a contact the
@@ -1464,7 +1492,7 @@ class ContactSimulator:
             if (
                 t - t == 0.0
                 and d - d == 0.0
-                and t >= time0
+                and (t == time0 or t - time0 >= MIN_TIME_STEP)
                 and not (d < 0.0 and d_prev < 0.0 and r0 <= 0.0 and model.is_relaxed())
             ):
                 row = model.row
@@ -1533,6 +1561,8 @@ class ContactSimulator:
                         if status == 0:  # _kernels.STATUS_OK
                             energy = energy0 + work
                             dissipated = dissipated0 + step_dissipated
+                            if not (energy - energy == 0.0 and dissipated - dissipated == 0.0):
+                                raise _overflow(energy, dissipated)
                             # The output first (nothing changed yet if it fails), then the
                             # commit. Filling the instance's dict item by item is cheaper than
                             # a dict display (`_new_output`).
@@ -1587,6 +1617,8 @@ class ContactSimulator:
                     dt = t - time0
                     radius, f, work = model.advance(d_prev, d, dt)
                     energy = energy0 + work
+                    if not (energy - energy == 0.0 and model.dissipated - model.dissipated == 0.0):
+                        raise _overflow(energy, model.dissipated)
                     physics = self.physics
                     g_edge = model._edge[2] if radius > 0.0 else 0.0
                     phase = _phase(model, physics, d, r0, radius, g_edge)
@@ -1651,7 +1683,9 @@ class ContactSimulator:
         that branch does not apply or does not find the root (a trial detached, a slope
         unlike the last, a step the domain cannot hold): the general path then runs the
         step from the start (the same trials again, 0.2 % of the default scene's rows)."""
-        if not (t - t == 0.0 and target - target == 0.0 and t >= self._time):
+        if not (
+            t - t == 0.0 and target - target == 0.0 and (t == self._time or t - self._time >= MIN_TIME_STEP)
+        ):
             return None  # the general path says what is wrong
         before = self._output
         memo = self._force_memo
@@ -1685,13 +1719,8 @@ class ContactSimulator:
         token = model.begin()
         start = model.trial_start()
         radius0, dissipated0 = model.radius, model.dissipated
-        # `advance`'s rule for the force known at the start (the first trial only: a rewind
-        # forgets it).
-        known = model._force_at
-        if known is not None and known[0] is row and known[1] == radius0 and known[2] == d0 and d0 != 0.0:
-            force_prev = known[3]
-        else:
-            force_prev = math.nan
+        # The force known at the start (the first trial only: a rewind forgets it).
+        force_prev = model._start_force(row, d0)
         trials: list[tuple[float, float, float]] = []
         energy0 = self._energy_input
         try:
@@ -1738,20 +1767,8 @@ class ContactSimulator:
                     result = None
                     grow = True
                     break
+                model._stepped(row, result, x_new, dissipated0)
                 radius, f = result[1], result[2]
-                # `advance`'s bookkeeping after its kernel call.
-                model.radius = radius
-                model.substeps = result[4]
-                model.dissipated = dissipated0 + result[5]
-                model._memory_peak = result[6]
-                model._edge = result[7]
-                model._edge_depth = x_new
-                model._force_at = (row, radius, x_new, f)
-                if row is not model._prepare_row:
-                    model._prepare_row = row
-                    model._prepare_radius = PREPARE_FRACTION * row.length
-                elif radius > model._prepare_radius:
-                    model._prepare_growth(row)
                 trials.append((x_new, f, radius))
                 last = [x_new, (radius, f, result[3])]
                 r_new = f - target
@@ -1790,6 +1807,8 @@ class ContactSimulator:
                 return output
             # `_publish` of the trial at the root (the model is in its state).
             energy = energy0 + result[3]
+            if not (energy - energy == 0.0 and model.dissipated - model.dissipated == 0.0):
+                raise _overflow(energy, model.dissipated)
             output = _object_new(StepOutput)
             values = output.__dict__
             values["time"] = t
@@ -1904,6 +1923,13 @@ class ContactSimulator:
             raise InputError(
                 "time must not go backwards (times must be non-decreasing from the current time)"
             )
+        steps = np.diff(t, prepend=self._time)
+        short = np.flatnonzero((steps > 0.0) & (steps < MIN_TIME_STEP))
+        if short.size:
+            raise InputError(
+                f"time[{int(short[0])}]: a time step of {steps[short[0]]!r} s is shorter than the "
+                f"shortest the model takes ({MIN_TIME_STEP!r} s)"
+            )
         if t.size == 0:
             return _empty_columns()
         if isinstance(self._model, _TimeStepped):
@@ -1918,6 +1944,9 @@ class ContactSimulator:
         r0 = np.concatenate(([self._output.contact_radius], radius[:-1]))
         dt = np.diff(t, prepend=self._time)
         energy_input = np.cumsum(np.concatenate(([self._energy_input], work)))[1:]
+        bad = np.flatnonzero(~(np.isfinite(energy_input) & np.isfinite(dissipated)))
+        if bad.size:
+            raise _overflow(float(energy_input[bad[0]]), float(dissipated[bad[0]]))
         # `_phase` on columns. g at the edge as the kernel saw it (0 without contact), like `step`.
         g = gaps[:, 2]
         tol = 1e-9 * (np.abs(d) + physics.c_crit * np.sqrt(radius) + g)
@@ -1985,19 +2014,32 @@ class ContactSimulator:
         dt = time - self._time
         r0 = self._output.contact_radius
         radius, force, work = result
-        self._energy_input += work
+        energy = self._energy_input + work
+        # The output first (it refuses a step whose energy overflowed), then the commit.
+        output = self._make_output(time, depth, force, r0, radius, dt, unstable, energy)
+        self._energy_input = energy
         self._time, self._depth = time, depth
-        self._output = self._make_output(time, depth, force, r0, radius, dt, unstable)
-        return self._output
+        self._output = output
+        return output
 
     def _make_output(
-        self, time: float, depth: float, force: float, r0: float, radius: float, dt: float, unstable: bool
+        self,
+        time: float,
+        depth: float,
+        force: float,
+        r0: float,
+        radius: float,
+        dt: float,
+        unstable: bool,
+        energy_input: float,
     ) -> StepOutput:
         physics = self.physics
+        dissipated = self._model.energy_dissipated(energy_input, depth)
+        if not (math.isfinite(energy_input) and math.isfinite(dissipated)):
+            raise _overflow(energy_input, dissipated)
         g_edge = self._model.edge_height(radius) if radius > 0.0 else 0.0
         phase = _phase(self._model, physics, depth, r0, radius, g_edge)
         edge_speed = (radius - r0) / dt if dt > 0.0 else 0.0
-        dissipated = self._model.energy_dissipated(self._energy_input, depth)
         u = depth - g_edge
         effective = physics.e_relaxed * u * u / (2.0 * math.pi * radius) if radius > 0.0 and u < 0.0 else 0.0
         return _new_output(
@@ -2008,7 +2050,7 @@ class ContactSimulator:
             phase,
             edge_speed,
             effective,
-            self._energy_input,
+            energy_input,
             dissipated,
             physics.scale_separation_ok(edge_speed),
             unstable,
@@ -2193,9 +2235,7 @@ class ContactSimulator:
             if r_hi * direction >= 0.0 and not (detached and r_hi == 0.0 and adhesive):
                 break
             if detached:
-                found, boundary = self._search_dip(
-                    residual, trials, target, golden_section=not dip_searched
-                )
+                found, boundary = self._search_dip(residual, trials, target, golden_section=not dip_searched)
                 if found is None:
                     return self._pulled_off(boundary, time, start, last)
                 lo, r_lo, hi, r_hi = found
