@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from force_histories import apply, cases, default_contact, finger_contact
+from scenes import one_contact
 
 from viscoadh_ros.bench.kernel import hold_pull_forces
 from viscoadh_ros.core import _kernels, simulator
@@ -135,15 +136,30 @@ def test_a_push_back_in_after_a_pull_off_meets_its_target() -> None:
         assert abs(out.force - target) <= tolerance * target, out
 
 
-def test_a_hard_pull_lets_go_where_a_gentle_one_does() -> None:
+def _closed_form_sphere():
+    return one_contact({"shape": "sphere", "radius": 5e-3}, work=0.05)
+
+
+def _closed_form_cone():
+    return one_contact({"shape": "cone", "half_angle": 1.3}, work=0.05)
+
+
+@pytest.mark.parametrize(
+    "make",
+    [default_contact, _closed_form_sphere, _closed_form_cone],
+    ids=["time_stepped", "closed_form_sphere", "closed_form_cone"],
+)
+def test_a_hard_pull_lets_go_where_a_gentle_one_does(make) -> None:
     """Pulled from a pressed contact with forces no attached depth reaches, from 3x its
     adhesive force to -1e308 N, the contact lets go at the same depth (the detachment
     bisected to the tolerance of where it holds, not of the force pulled or of the far
     detached trial), every output finite, and it can be pushed back in. Before 0.8.0, -1e100 N
     published a depth of -1e71 m and an energy of 1e136 J (-1e200 N: NaN), after which a push
     was refused as beyond the domain, and the let-go depth moved with the force (-1.23 um at
-    -1 N, -4.7 um at -1e6 N)."""
-    contact = default_contact()
+    -1 N, -4.7 um at -1e6 N). The closed forms (elastic, no domain) likewise: -1e100 N let go
+    at -1.9e53 m, and the next push was refused (outside tester, 0.8.0)."""
+    contact = make()
+    assert ContactSimulator(contact).model == ("time_stepped" if make is default_contact else "closed_form")
     pulls = (-0.05, -1.0, -1e3, -1e6, -1e100, -1e200, -1e308)
     outputs, pushed = [], []
     held = 0.0

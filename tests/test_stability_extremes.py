@@ -321,12 +321,15 @@ def test_a_time_step_below_the_shortest_is_refused_by_step_depths_too() -> None:
 
 @pytest.mark.parametrize("control", ["force", "depth"])
 def test_a_push_whose_energy_overflows_is_refused(control: str) -> None:
-    """A flat punch's contact radius is fixed, so no domain limit refuses an absurd push:
+    """A flat punch's contact radius is fixed, so no domain limit refused an absurd push:
     1e154 N (or the depth it reaches) overflowed the energies to inf and the step was taken
-    (outside tester, 0.8.0). Such a step is refused and changes nothing; a finite one is kept."""
+    (outside tester, 0.8.0). The depth limit refuses such pushes now (the test above); behind
+    it, every publish path refuses a step whose energy is not finite (here with the depth
+    limit lifted), and changes nothing; a finite step is kept."""
     from viscoadh_ros.core.errors import InputError
 
     sim = ContactSimulator(_punch())
+    sim._depth_limit = math.inf
     sim.step(1e-3, force=1e-3)
     before = _frozen(sim)
     with pytest.raises(InputError, match="energy is not finite"):
@@ -337,3 +340,35 @@ def test_a_push_whose_energy_overflows_is_refused(control: str) -> None:
     assert _frozen(sim) == before
     out = sim.step(2e-3, force=2e-3)
     assert all(math.isfinite(getattr(out, name)) for name in FIELDS)
+
+
+@pytest.mark.parametrize(
+    "contact, command",
+    [
+        # A flat punch's contact radius is fixed: 1e15 N reached 1.9e11 m, and the next 0.01 N
+        # was answered with 0.13 N (the memory's rounding at that scale).
+        (_punch, {"force": 1e15}),
+        (_punch, {"depth": 1e10}),
+        # The closed form (elastic sphere) has no domain at all: 1e10 m was taken and 1e50 N
+        # answered with 5.9e49 N (outside tester, 0.8.0).
+        (lambda: one_contact({"shape": "sphere", "radius": 5e-3}, work=0.05), {"depth": 1e10}),
+        (lambda: one_contact({"shape": "sphere", "radius": 5e-3}, work=0.05), {"force": 1e50}),
+    ],
+    ids=["punch_force", "punch_depth", "closed_form_depth", "closed_form_force"],
+)
+def test_a_depth_beyond_the_largest_domain_is_refused_on_every_model(contact: Any, command: dict) -> None:
+    """|depth| may not pass the largest domain a time-stepped contact of the scene can reach
+    (`simulator._depth_limit`, 1e3 m here), whatever the model: the step is refused (naming the
+    limit), changes nothing, and the contact goes on as one that never saw it."""
+    from viscoadh_ros.core.errors import InputError
+
+    sim, reference_sim = ContactSimulator(contact()), ContactSimulator(contact())
+    for k in range(1, 4):
+        sim.step(k * 1e-3, force=1e-2)
+        reference_sim.step(k * 1e-3, force=1e-2)
+    before = _frozen(sim)
+    with pytest.raises(InputError, match="beyond the scene.s range.*largest domain"):
+        sim.step(4e-3, **command)
+    assert _frozen(sim) == before
+    for k in range(4, 8):
+        assert sim.step(k * 1e-3, force=1e-2 * (k - 2)) == reference_sim.step(k * 1e-3, force=1e-2 * (k - 2))

@@ -1158,6 +1158,29 @@ FOLD_SLOPE = 0.3
 MIN_TIME_STEP = 1e-300
 
 
+def _depth_limit(physics: Any, numerics: Any) -> float:
+    """|depth| a step may reach, m: the largest domain `_TimeStepped._grow` lets a contact of
+    this scene reach (1e6 x its first domain, at least 1e3 m). Beyond it a flat punch took
+    1.9e11 m under 1e15 N and answered the next 0.01 N with 0.13 N (the memory's rounding at
+    that scale), and the closed form took 1e10 m."""
+    initial = float(numerics.domain_radius)  # as `_TimeStepped` picks its first domain
+    punch = getattr(physics.profile, "punch_radius", None)
+    if initial <= 0.0 and punch is not None:
+        initial = float(punch)
+    elif initial <= 0.0 and physics.work_of_adhesion > 0.0:
+        initial = 2.0 * physics.adhesion_length()
+    if punch is not None:
+        initial = min(initial, float(punch))
+    return max(1e6 * initial, 1e3)
+
+
+def _beyond_depth_limit(depth: float, limit: float) -> InputError:
+    return InputError(
+        f"depth {depth!r} m is beyond the scene's range: |depth| may be at most {limit:.3g} m, "
+        "the largest domain this contact can represent (a force that needs it cannot be reached)"
+    )
+
+
 def _overflow(energy_input: float, energy_dissipated: float) -> InputError:
     """The error of a step whose energy overflowed (a force or depth far beyond what the
     scene represents, e.g. 1e154 N on a flat punch, which no domain limit refuses)."""
@@ -1165,6 +1188,8 @@ def _overflow(energy_input: float, energy_dissipated: float) -> InputError:
         f"the step's energy is not finite (energy input {energy_input!r} J, dissipated "
         f"{energy_dissipated!r} J): the force or depth is far beyond the scene's range"
     )
+
+
 #: Converged force steps in a row the force search's first trial extrapolates its depth from.
 PATH_POINTS = 4
 
@@ -1350,6 +1375,10 @@ class ContactSimulator:
             self._model = _TimeStepped(self.physics, self.numerics)
         # Depth steps may take the lean path in `step` (the time-stepped model only).
         self._lean = isinstance(self._model, _TimeStepped)
+        # The deepest |depth| a step may reach, m: the largest domain a time-stepped contact
+        # of this scene can represent (`_TimeStepped._grow`), on every model (a flat punch,
+        # whose contact radius is fixed, and the closed forms have no domain to outgrow).
+        self._depth_limit = _depth_limit(self.physics, self.numerics)
         # The physics constants the compiled step derives its outputs from (`_STEP`).
         self._e_relaxed = float(self.physics.e_relaxed)
         self._v_c1, self._v_c2 = (float(v) for v in self.physics.critical_speeds)
@@ -1491,7 +1520,7 @@ class ContactSimulator:
             time0 = self._time
             if (
                 t - t == 0.0
-                and d - d == 0.0
+                and abs(d) <= self._depth_limit
                 and (t == time0 or t - time0 >= MIN_TIME_STEP)
                 and not (d < 0.0 and d_prev < 0.0 and r0 <= 0.0 and model.is_relaxed())
             ):
@@ -1739,11 +1768,15 @@ class ContactSimulator:
                     x_new = x - r / tangent
                     if x_new == x or abs(x_new - x) * FOLD_SLOPE * glass > abs(r):
                         break
+                    if not abs(x_new) <= self._depth_limit:
+                        break  # `_predicted_root`: no trial beyond it, the search decides
                     _kernels._restore_state(row.wl, row.wsum, row.wb, row.bsum, row.txn, row.txn_b)
                     model.radius = radius0
                     model.dissipated = dissipated0
                 else:
                     x_new = x
+                    if not abs(x_new) <= self._depth_limit:
+                        break
                 model._force_at = None
                 model._journal = row
                 result = _STEP(
@@ -1923,6 +1956,11 @@ class ContactSimulator:
             raise InputError(
                 "time must not go backwards (times must be non-decreasing from the current time)"
             )
+        deep = np.flatnonzero(np.abs(d) > self._depth_limit)
+        if deep.size:
+            raise InputError(
+                f"depth[{int(deep[0])}]: {_beyond_depth_limit(float(d[deep[0]]), self._depth_limit)}"
+            )
         steps = np.diff(t, prepend=self._time)
         short = np.flatnonzero((steps > 0.0) & (steps < MIN_TIME_STEP))
         if short.size:
@@ -1997,6 +2035,8 @@ class ContactSimulator:
     def _trial(self, time: float, depth: float) -> tuple[float, float, float]:
         """Advance the model (only) from the current state to (time, depth); returns
         (radius m, force N, work J). An idle contact above the surface costs nothing."""
+        if not abs(depth) <= self._depth_limit:
+            raise _beyond_depth_limit(depth, self._depth_limit)
         if depth < 0.0 and self._depth < 0.0 and self.is_idle:
             if isinstance(self._model, _TimeStepped):
                 self._model.drop_memory()
@@ -2205,14 +2245,17 @@ class ContactSimulator:
             # overshot the root 3x into a deep, dear trial (57 substeps, a third of the step).
             stiffness *= self.physics.e0 / self.physics.e_relaxed
         delta = max(abs(r_hold) / stiffness, 1e-12 * (abs(d0) + 1e-12))
-        row = getattr(model, "row", None)
-        if direction < 0.0 and row is not None:
-            # A pull needs no trial farther above the held depth than the domain is long:
-            # the contact lets go well before (its adhesive neck and the memory's depression
-            # are a fraction of the contact radius, which the domain exceeds). The Newton step
-            # of an absurd pull (-1e100 N over the stiffness) went to -1e71 m and published
-            # that depth, non-finite energies and a contact that could not be pushed back.
-            delta = min(delta, row.length)
+        if direction < 0.0:
+            # A pull needs no trial farther above the held depth than the domain is long (on
+            # the closed form: 4x the contact radius or the held depth): the contact lets go
+            # well before (its adhesive neck and the memory's depression are a fraction of the
+            # contact radius, which the domain exceeds). The Newton step of an absurd pull
+            # (-1e100 N over the stiffness) went to -1e71 m and published that depth,
+            # non-finite energies and a contact that could not be pushed back.
+            row = getattr(model, "row", None)
+            reach = row.length if row is not None else 4.0 * max(self._output.contact_radius, abs(d0))
+            if reach > 0.0:
+                delta = min(delta, reach)
         lo, r_lo = d0, r_hold
         # Pulled to a zero force, an adhesive contact holds it before it lets go; a detached
         # trial (zero force too) is no root then: look for the attached one.
@@ -2370,6 +2413,8 @@ class ContactSimulator:
         (up to PREDICTED_TRIALS_CONVERGING while each cuts the residual 100-fold) did not
         converge."""
         x = first
+        if not abs(x) <= self._depth_limit:
+            return None  # the search decides whether the force can be reached
         r = residual(x)
         if not self._attached():
             return None
@@ -2383,7 +2428,11 @@ class ContactSimulator:
             if trial > self.PREDICTED_TRIALS and not shrunk:
                 return None
             x_new = x - r / tangent
-            if x_new == x or abs(x_new - x) * FOLD_SLOPE * glass > abs(r):
+            if (
+                x_new == x
+                or abs(x_new - x) * FOLD_SLOPE * glass > abs(r)
+                or not abs(x_new) <= self._depth_limit
+            ):
                 return None
             r_new = residual(x_new)
             if not self._attached():
