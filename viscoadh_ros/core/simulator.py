@@ -1690,9 +1690,10 @@ class ContactSimulator:
                     self._energy_input, self._time, self._depth = energy0, time0, d_prev
                     self._output, self._held_force = output0, held0
                     raise
-        elif depth is None and self._lean:
+        elif depth is None and self._lean and type(self._force_memo) is tuple:
             # The lean force path: a force step whose predicted root holds (85 % of the
-            # default scene's force rows) in one frame, else the general path below.
+            # default scene's force rows) in one frame, else the general path below (also
+            # straight away without a prediction: out of contact, after a pull-off).
             if type(force) is float and type(time) is float:
                 output = self._predicted_force_step(time, force)
             elif isinstance(force, float) and isinstance(time, float):
@@ -2164,7 +2165,7 @@ class ContactSimulator:
                 self._remember(output, before, trials, d0, f0, dt, None, slope)
                 return output
             trials.clear()
-        return self._search_force(time, target, start, last, trials)
+        return self._search_force(time, target, start, last, trials, residual, stop)
 
     def _residual(
         self,
@@ -2197,20 +2198,25 @@ class ContactSimulator:
         start: Any,
         last: list[Any],
         trials: list[tuple[float, float, float]],
+        residual: Any = None,
+        stop: float = math.nan,
     ) -> StepOutput:
         """`_solve_force` after its predicted root (none, or it did not hold): the search from
         rest or the bracketing search from the held depth. `start`: the model's state before
         the step; `last`: the last trial (depth None when none ran yet) or the failed
-        prediction's; `trials`: empty."""
+        prediction's; `trials`: empty; `residual` (`_residual` over `last` and `trials`) and
+        `stop` (`_force_stop`) when the caller has them."""
         model = self._model
         d0 = self._depth
         before = self._output
         f0 = before.force
         tol = self.numerics.force_tolerance * max(abs(target), abs(f0), 1e-300)
-        stop = self._force_stop(target, before.contact_radius)
+        if stop != stop:
+            stop = self._force_stop(target, before.contact_radius)
         was_in_contact = self.in_contact
         memo = self._force_memo
-        residual = self._residual(time, target, start, last, trials)
+        if residual is None:
+            residual = self._residual(time, target, start, last, trials)
         cold = self._from_rest(residual, d0, target, stop) if not was_in_contact else None
         if cold is not None:
             lo, r_lo, hi, r_hi, stop = cold
