@@ -106,6 +106,12 @@ def test_force_history_and_preset(scene: Path, tmp_path: Path) -> None:
         ("time,depth\n0,1e-6\n0,2e-6\n", ":3: column 'time' must increase"),
         ("time,depth\n0,1e-6,3\n", ":2: expected 2 columns"),
         ("time,depth\n", "no samples"),
+        # Python's float() reads these, a CSV number is neither (0.8.0: "1_0" was 10 m).
+        ("time,depth\n0,1e-6\n0.1,1_0\n", ":3: column 'depth' is not a number ('1_0')"),
+        ("time,depth\n0,1e-6\n0.1,\uff12e-5\n", ":3: column 'depth' is not a number"),
+        # Beyond the largest domain (0.8.0), and a time step below the shortest.
+        ("time,depth\n0,1e-6\n0.1,2e3\n", "beyond the scene's range"),
+        ("time,depth\n0,1e-6\n5e-324,2e-6\n", "time[1]: a time step of 5e-324 s is shorter"),
     ],
 )
 def test_bad_history_is_one_line_error(
@@ -158,3 +164,36 @@ def test_an_output_in_a_missing_folder_is_refused_before_running(scene: Path, tm
     err = capsys.readouterr().err.strip()
     assert "does not exist" in err and "\n" not in err, err
     assert not out.parent.exists(), "no folder is created"
+
+
+@pytest.mark.parametrize("target", ["scene", "history"])
+def test_an_output_on_an_input_is_refused(scene: Path, tmp_path: Path, capsys, target: str) -> None:
+    """`-o` naming the scene or the history replaced it with the results and exited 0 (0.8.0's
+    outside tester; replay, fit and plot refused it already): refused, the input unchanged."""
+    history = write_history(tmp_path / "h.csv", "time,depth", np.array([[0.0, 1e-6], [0.1, 2e-6]]))
+    victim = scene if target == "scene" else history
+    before = victim.read_bytes()
+    code = main(["simulate", str(scene), str(history), "-o", str(victim), "--contact", "finger"])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and "would overwrite the input" in err and "\n" not in err, err
+    assert victim.read_bytes() == before
+
+
+def test_an_adhesive_neck_beyond_any_domain_is_a_one_line_error(tmp_path: Path, capsys) -> None:
+    """A power law that rises slower than the adhesive neck (exponent 0.1, coefficient 1e-30)
+    passes the scene's ranges, but its neck radius search ran to 1e300 m: a traceback from the
+    first row's element width (0.8.0's outside tester). Now one line, exit 2."""
+    path = tmp_path / "flat.yaml"
+    path.write_text(
+        "/**:\n  ros__parameters:\n    contacts: [probe]\n    probe:\n"
+        "      indenter: {shape: power_law, coefficient: 1.0e-30, exponent: 0.1}\n"
+        "      material: {glass_shear_modulus: 1.0e6, kelvin_shear_moduli: [1.0e5],\n"
+        "                 kelvin_viscosities: [1.1e4]}\n"
+        "      adhesion: {work_of_adhesion: 0.05}\n"
+    )
+    assert "power_law" in path.read_text()
+    history = write_history(tmp_path / "h.csv", "time,depth", np.array([[0.0, 1e-6]]))
+    code = main(["simulate", str(path), str(history), "-o", str(tmp_path / "o.csv"), "--contact", "probe"])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and "no first domain" in err and "\n" not in err, err
+    assert not (tmp_path / "o.csv").exists()

@@ -372,3 +372,26 @@ def test_a_depth_beyond_the_largest_domain_is_refused_on_every_model(contact: An
     assert _frozen(sim) == before
     for k in range(4, 8):
         assert sim.step(k * 1e-3, force=1e-2 * (k - 2)) == reference_sim.step(k * 1e-3, force=1e-2 * (k - 2))
+
+
+@pytest.mark.parametrize(
+    "values, words",
+    [
+        ([1e-6, True], "depth[1] must be a number (got True)"),
+        (["1e-6", "2e-6"], "depth[0] must be a number (got '1e-6')"),
+        (np.array([True, False]), "depth must be a sequence of numbers (got booleans)"),
+        (np.array(["1e-6", "2e-6"]), "depth must be a sequence of numbers"),
+    ],
+)
+def test_simulate_history_takes_numbers_only(values: Any, words: str) -> None:
+    """Booleans and numeric text became 1 m or 0.001 N through numpy (0.8.0's outside tester),
+    though `step` refuses them: refused before anything runs, like `step`."""
+    from viscoadh_ros.core.errors import InputError
+    from viscoadh_ros.core.history import simulate_history
+
+    with pytest.raises(InputError) as refused:
+        simulate_history(_standard_solid(), [0.0, 1e-3], depth=values)
+    assert words in str(refused.value)
+    # The same numbers as numbers run.
+    result = simulate_history(_standard_solid(), [0.0, 1e-3], depth=[1e-6, 2e-6])
+    assert np.all(np.isfinite(result.force))

@@ -39,11 +39,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def main(args: argparse.Namespace) -> int:
+    from viscoadh_ros.cli._paths import refuse_overwrite
     from viscoadh_ros.core.config import SceneConfig
     from viscoadh_ros.core.history import simulate_history
     from viscoadh_ros.experiment import choose_contact
     from viscoadh_ros.io.csv_io import check_output_folder, read_history, write_result
 
+    # `-o` on the scene or the history replaced it with the results, exit 0 (0.8.0's tester).
+    refuse_overwrite([args.scene, args.history], [("--output", args.output)])
     check_output_folder(args.output)
     contact = choose_contact(SceneConfig.from_yaml(args.scene), args.contact)
     overrides: dict[str, object] = {

@@ -65,6 +65,18 @@ class HistoryResult:
 
 
 def _history_array(name: str, values: ArrayLike) -> FloatArray:
+    # Numbers only: numpy turns booleans and numeric text into floats (True -> 1 m,
+    # "0.001" -> 0.001 N), which `step` refuses since 0.8.0 (`errors.require_finite`).
+    if isinstance(values, np.ndarray):
+        if values.dtype.kind not in "iufO" and values.size:
+            kind = "booleans" if values.dtype.kind == "b" else f"{values.dtype.name} values"
+            raise InputError(f"{name} must be a sequence of numbers (got {kind})")
+        items = values.reshape(-1) if values.dtype.kind == "O" else ()
+    else:
+        items = values if isinstance(values, (list, tuple)) else ()
+    for index, item in enumerate(items):
+        if isinstance(item, (str, bytes, bool, np.bool_)):
+            raise InputError(f"{name}[{index}] must be a number (got {item!r})")
     try:
         array = np.asarray(values, dtype=np.float64)
     except (TypeError, ValueError):

@@ -435,6 +435,15 @@ class _TimeStepped:
             self.initial_length = 0.0  # chosen from the depth at first contact
         if self.punch_radius is not None:
             self.initial_length = min(self.initial_length, self.punch_radius)
+        if numerics.domain_radius <= 0.0 and not self.initial_length <= FIRST_DOMAIN_LIMIT:
+            # A profile that rises slower than the adhesive neck (a power law with exponent
+            # <= 0.5 and a tiny coefficient): the neck radius search ran to 1e300 m and the
+            # first row's element width overflowed (a traceback from `Row`, 0.8.0's tester).
+            raise ConfigError(
+                f"no first domain: the adhesive neck where contact starts has a radius of "
+                f"{self.initial_length:.3g} m (over {FIRST_DOMAIN_LIMIT:g} m): adhesion beats the "
+                "profile's rise; make the indenter steeper or work_of_adhesion smaller"
+            )
         # The first contact's domain, built once here (about 0.1 ms: the fine profile grid and
         # its checks) rather than inside the snap-in step; each new contact takes a copy of
         # it with zero memory.
@@ -1152,6 +1161,9 @@ def _phase(model: Any, physics: _Physics, depth: float, r0: float, radius: float
 #: from it a step's slope is 0.46 to 1 times the glass stiffness on the bench's history).
 FOLD_SLOPE = 0.3
 
+#: The largest first domain (m) a time-stepped contact starts from (`_TimeStepped`).
+FIRST_DOMAIN_LIMIT = 1e3
+
 #: The shortest time step (s) a step takes; a shorter one (other than none: a jump at one
 #: time) is refused. Below it the substep control halved steps to zero (a ZeroDivisionError
 #: at 6e-322 s) and an edge speed overflowed.
@@ -1489,7 +1501,7 @@ class ContactSimulator:
         if 0.0 < t - self._time < MIN_TIME_STEP:
             raise InputError(
                 f"time step {t - self._time!r} s is shorter than the shortest the model takes "
-                f"({MIN_TIME_STEP!r} s): repeat the last time for a jump, or step further"
+                f"({MIN_TIME_STEP!r} s)"
             )
         return t
 
@@ -1952,7 +1964,7 @@ class ContactSimulator:
         for name, values in (("time", t), ("depth", d)):
             bad = np.flatnonzero(~np.isfinite(values))
             if bad.size:
-                raise InputError(f"{name}[{int(bad[0])}] must be finite (got {values[bad[0]]!r})")
+                raise InputError(f"{name}[{int(bad[0])}] must be finite (got {float(values[bad[0]])!r})")
         if t.size and (t[0] < self._time or np.any(np.diff(t) < 0.0)):
             raise InputError(
                 "time must not go backwards (times must be non-decreasing from the current time)"
@@ -1966,7 +1978,7 @@ class ContactSimulator:
         short = np.flatnonzero((steps > 0.0) & (steps < MIN_TIME_STEP))
         if short.size:
             raise InputError(
-                f"time[{int(short[0])}]: a time step of {steps[short[0]]!r} s is shorter than the "
+                f"time[{int(short[0])}]: a time step of {float(steps[short[0]])!r} s is shorter than the "
                 f"shortest the model takes ({MIN_TIME_STEP!r} s)"
             )
         if t.size == 0:

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import csv
 import math
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -60,7 +61,18 @@ def _rows(path: str | Path, what: str) -> list[tuple[int, list[str]]]:
     ]
 
 
+#: A decimal number as a CSV cell may hold one (Python's `float` also takes "1_0", full-width
+#: digits and other Unicode digits, which a spreadsheet would not write; 0.8.0's tester found
+#: "1_0" read as 10 m): sign, digits with an optional point, an optional exponent, or
+#: inf/nan (refused as not finite, with their own message).
+_NUMBER = re.compile(
+    r"[+-]?(?:(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?|inf(?:inity)?|nan)", re.IGNORECASE
+)
+
+
 def _number(name: str, line: int, column: str, text: str) -> float:
+    if not _NUMBER.fullmatch(text.strip()):
+        raise InputError(f"{name}:{line}: column {column!r} is not a number ({text!r})")
     try:
         number = float(text)
     except ValueError:
