@@ -197,3 +197,21 @@ def test_an_adhesive_neck_beyond_any_domain_is_a_one_line_error(tmp_path: Path, 
     err = capsys.readouterr().err.strip()
     assert code == 2 and "no first domain" in err and "\n" not in err, err
     assert not (tmp_path / "o.csv").exists()
+
+
+@pytest.mark.parametrize(
+    "argv, words",
+    [
+        (["simulate"], "the following arguments are required"),
+        (["simulate", "a.yaml", "b.csv", "-o", "c.csv", "--preset", "turbo"], "invalid choice: 'turbo'"),
+        (["nosuchverb"], "invalid choice: 'nosuchverb'"),
+    ],
+)
+def test_a_usage_error_is_one_line(capsys, argv: list[str], words: str) -> None:
+    """docs/cli.md: a usage error is one line on stderr and exit 2 (argparse printed its usage
+    block first, 6-9 lines: 0.8.0's outside tester)."""
+    with pytest.raises(SystemExit) as raised:
+        main(argv)
+    err = capsys.readouterr().err
+    assert raised.value.code == 2
+    assert err.count("\n") == 1 and words in err and err.startswith("viscoadh"), err

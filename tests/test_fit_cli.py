@@ -239,7 +239,6 @@ def test_a_curved_valley_widens_the_interval_to_the_truth(tmp_path: Path) -> Non
     assert row["status"] == "unidentified", row
 
 
-
 @pytest.mark.parametrize("after", [1, 3, 40])
 def test_a_record_ending_at_or_right_after_its_most_tensile_sample_is_an_input_error(
     tmp_path: Path, capsys, after: int
@@ -264,3 +263,20 @@ def test_a_record_ending_at_or_right_after_its_most_tensile_sample_is_an_input_e
         assert "pull-off" in err and "Traceback" not in err, err
     else:
         assert code == 0, err
+
+
+def test_a_record_with_a_depth_beyond_the_scene_is_an_input_error_naming_it(tmp_path: Path, capsys) -> None:
+    """One sample at 1e4 m (beyond the largest domain, refused by every model run since 0.8.0):
+    the fit ran into refused trials and reported a secant that would not converge (0.8.0's
+    outside tester). It now names the sample before fitting, as replay does."""
+    time, depth = standard_history(200)
+    force = true_force(TRUE, time, depth)
+    depth = depth.copy()
+    depth[80] = 1e4
+    path = tmp_path / "deep.mcap"
+    write_record(path, time, depth, force, noise=0.01, seed=2)
+    start = write_scene(tmp_path / "start.yaml", TRUE)
+    code = main(_fit_args(path, start, tmp_path / "fitted.yaml"))
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and "depth[80]: 10000.0 m is beyond the scene's range" in err and "\n" not in err, err
+    assert not (tmp_path / "fitted.yaml").exists()

@@ -953,6 +953,23 @@ def _profile_inflation(
     return factors
 
 
+def _check_depths(contact: ContactConfig, experiment: Experiment) -> None:
+    """InputError naming the first commanded depth beyond the scene's range (the largest
+    domain, `simulator._depth_limit`, at the scene's parameters): every model run refuses it,
+    so the fit used to run into a wall of refused trials and report a secant that would not
+    converge (0.8.0's outside tester); `replay` names the sample."""
+    from viscoadh_ros.core.simulator import ContactSimulator
+
+    limit = ContactSimulator(contact)._depth_limit
+    deep = np.flatnonzero((experiment.input_mode == DEPTH) & ~(np.abs(experiment.input_value) <= limit))
+    if deep.size:
+        value = float(experiment.input_value[deep[0]])
+        raise InputError(
+            f"depth[{int(deep[0])}]: {value!r} m is beyond the scene's range (at most {limit:.3g} m, "
+            "the largest domain this contact can represent): no model run can replay the record"
+        )
+
+
 def fit(
     contact: ContactConfig,
     experiment: Experiment,
@@ -982,6 +999,7 @@ def fit(
             raise InputError(f"start value of {name} must be finite and > 0 (got {start[name]})")
     if ordered:
         start = by_retardation(start, kelvin)
+    _check_depths(contact, experiment)
     noise = _noise_floor(experiment.measured_force)
     depth = np.interp(
         experiment.time(experiment.measured_ns), experiment.time(experiment.input_ns), experiment.input_value

@@ -21,6 +21,7 @@ import importlib
 import sys
 from collections.abc import Sequence
 from types import ModuleType
+from typing import NoReturn
 
 from viscoadh_ros import __version__
 
@@ -89,10 +90,19 @@ def _user_error_types() -> tuple[type[BaseException], ...]:
     return (ConfigError, InputError)
 
 
+class _OneLineParser(argparse.ArgumentParser):
+    """An ArgumentParser whose usage errors are one line on stderr and exit 2, as docs/cli.md
+    promises for every usage or input error (argparse prints its usage block first: 6-9
+    lines, 0.8.0's outside tester); the usage stays one `--help` away."""
+
+    def error(self, message: str) -> NoReturn:
+        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
 def build_parser(verb: str | None = None) -> tuple[argparse.ArgumentParser, ModuleType | None]:
     """The top-level parser with a subparser per verb; ``verb``'s own arguments are added
     from its module (imported here). Returns the parser and that module (None if absent)."""
-    parser = argparse.ArgumentParser(
+    parser = _OneLineParser(
         prog=PROG,
         description="Adhesive contact with viscoelastic materials (MDR + energy criterion), "
         "offline and as a ROS 2 node.",
