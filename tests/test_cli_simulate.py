@@ -215,3 +215,14 @@ def test_a_usage_error_is_one_line(capsys, argv: list[str], words: str) -> None:
     err = capsys.readouterr().err
     assert raised.value.code == 2
     assert err.count("\n") == 1 and words in err and err.startswith("viscoadh"), err
+
+
+def test_a_key_beside_the_node_sections_is_named(tmp_path: Path, capsys) -> None:
+    """A params file with something else beside its `/**` section was refused as "contacts is
+    required", though contacts are there (0.8.0's outside tester): the stray key is named."""
+    path = tmp_path / "notes.yaml"
+    path.write_text(SCENE + "notes: hello\n")
+    history = write_history(tmp_path / "h.csv", "time,depth", np.array([[0.0, 1e-6]]))
+    code = main(["simulate", str(path), str(history), "-o", str(tmp_path / "o.csv"), "--contact", "finger"])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and "notes: not a node section" in err and "\n" not in err, err

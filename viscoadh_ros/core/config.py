@@ -315,6 +315,19 @@ def _unwrap(mapping: Mapping[str, Any]) -> dict[str, Any]:
     wrapped = bool(mapping) and all(
         isinstance(value, Mapping) and set(value) == {"ros__parameters"} for value in mapping.values()
     )
+    sections = [
+        key for key, value in mapping.items() if isinstance(value, Mapping) and "ros__parameters" in value
+    ]
+    if sections and not wrapped:
+        # A params file with something else beside its node sections: flattened as a bare
+        # mapping, it was refused as "contacts is required" (0.8.0's outside tester).
+        other = next(
+            key for key in mapping if key not in sections or set(mapping[key]) != {"ros__parameters"}
+        )
+        raise ConfigError(
+            f"{other!s}: not a node section; a parameters file holds only "
+            f"'<node name>: {{ros__parameters: ...}}' sections (found {', '.join(map(str, sections))})"
+        )
     flat: dict[str, Any] = {}
     if wrapped:
         for node_name, section in mapping.items():
