@@ -226,3 +226,27 @@ def test_a_key_beside_the_node_sections_is_named(tmp_path: Path, capsys) -> None
     code = main(["simulate", str(path), str(history), "-o", str(tmp_path / "o.csv"), "--contact", "finger"])
     err = capsys.readouterr().err.strip()
     assert code == 2 and "notes: not a node section" in err and "\n" not in err, err
+
+
+def test_another_nodes_section_is_left_to_that_node(tmp_path: Path, capsys) -> None:
+    """A params file for several nodes: `simulate` takes the sections the node takes (`/**`,
+    `viscoadh`), as `viscoadh node` runs the file; it merged every section and refused the other
+    node's keys as unknown parameters (0.8.0's outside tester)."""
+    path = tmp_path / "two.yaml"
+    path.write_text(SCENE + "other_node:\n  ros__parameters:\n    foo: 1\n")
+    history = write_history(tmp_path / "h.csv", "time,depth", np.array([[0.0, 1e-6], [0.1, 2e-6]]))
+    out = tmp_path / "o.csv"
+    code = main(["simulate", str(path), str(history), "-o", str(out), "--contact", "finger"])
+    assert code == 0, capsys.readouterr().err
+    alone = tmp_path / "alone.csv"
+    assert (
+        main(["simulate", str(scene_file(tmp_path)), str(history), "-o", str(alone), "--contact", "finger"])
+        == 0
+    )
+    assert out.read_bytes() == alone.read_bytes()
+
+
+def scene_file(tmp_path: Path) -> Path:
+    path = tmp_path / "alone.yaml"
+    path.write_text(SCENE)
+    return path

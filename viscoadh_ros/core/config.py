@@ -11,8 +11,9 @@ A scene is a ROS 2 parameters file::
           adhesion: {work_of_adhesion: 0.05}
         publish_rate: 50.0
 
-:meth:`SceneConfig.from_dict` accepts that mapping (any node name; several node sections
-are merged in file order), the bare ``ros__parameters`` mapping, or the flat dotted form
+:meth:`SceneConfig.from_dict` accepts that mapping (any node name; of several node sections
+those that apply to the node, ``/**`` and ``viscoadh``, merged in file order, as the node takes
+them, else all of them), the bare ``ros__parameters`` mapping, or the flat dotted form
 rclpy hands a node (``"finger.indenter.shape": "sphere"``). Everything funnels into
 :meth:`SceneConfig.from_parameters`, the one validator: unknown keys (with the closest valid
 key suggested), wrong types, out-of-range or non-finite values all raise
@@ -308,6 +309,12 @@ def _flatten(mapping: Mapping[str, Any], prefix: str, flat: dict[str, Any]) -> N
             flat[f"{prefix}{key}"] = value
 
 
+#: The node's default name (`viscoadh node`), and the params-file section names that apply
+#: to it.
+NODE_NAME = "viscoadh"
+_OWN_SECTIONS = frozenset({"/**", "**", "/*", "*", NODE_NAME, f"/{NODE_NAME}"})
+
+
 def _unwrap(mapping: Mapping[str, Any]) -> dict[str, Any]:
     """The flat dotted parameters of a params-file mapping, a bare mapping or a flat one."""
     if not isinstance(mapping, Mapping):
@@ -330,7 +337,14 @@ def _unwrap(mapping: Mapping[str, Any]) -> dict[str, Any]:
         )
     flat: dict[str, Any] = {}
     if wrapped:
-        for node_name, section in mapping.items():
+        # Several node sections: those the node (named `NODE_NAME` unless remapped) takes,
+        # as ROS applies a params file; others are another node's (0.8.0's outside tester:
+        # a second node's section was merged and refused as unknown parameters, while the
+        # node ran the file). None of them: every section, in file order.
+        applies = [name for name in mapping if str(name) in _OWN_SECTIONS]
+        chosen = applies if len(mapping) > 1 and applies else list(mapping)
+        for node_name in chosen:
+            section = mapping[node_name]
             parameters = section["ros__parameters"]
             if not isinstance(parameters, Mapping):
                 raise ConfigError(f"{node_name}.ros__parameters must be a mapping")

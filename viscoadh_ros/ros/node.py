@@ -53,7 +53,7 @@ from viscoadh_msgs.srv import PredictPullOff, SimulateHistory
 from visualization_msgs.msg import Marker
 
 from viscoadh_ros.core._kernels import warm_up
-from viscoadh_ros.core.config import ContactConfig, SceneConfig
+from viscoadh_ros.core.config import NODE_NAME, ContactConfig, SceneConfig
 from viscoadh_ros.core.errors import ConfigError, InputError
 from viscoadh_ros.core.hand import ContactStepError, step_contacts
 from viscoadh_ros.core.history import predict_pull_off, simulate_history
@@ -62,7 +62,6 @@ from viscoadh_ros.io import cdr
 from viscoadh_ros.io.mcap_log import McapRecorder, TopicQos, plain
 from viscoadh_ros.ros import conversions, diagnostics, markers, parameters
 
-NODE_NAME = "viscoadh"
 #: An idle contact (out of touch, relaxed) republishes its unchanging state at this period.
 IDLE_PUBLISH_PERIOD_NS = 1_000_000_000
 #: Period of /diagnostics.
