@@ -358,7 +358,7 @@ def test_a_push_whose_energy_overflows_is_refused(control: str) -> None:
 )
 def test_a_depth_beyond_the_largest_domain_is_refused_on_every_model(contact: Any, command: dict) -> None:
     """|depth| may not pass the largest domain a time-stepped contact of the scene can reach
-    (`simulator._depth_limit`, 1e3 m here), whatever the model: the step is refused (naming the
+    (`ContactSimulator._depth_limit`, 1e3 m here), whatever the model: the step is refused (naming the
     limit), changes nothing, and the contact goes on as one that never saw it."""
     from viscoadh_ros.core.errors import InputError
 

@@ -955,7 +955,7 @@ def _profile_inflation(
 
 def _check_depths(contact: ContactConfig, experiment: Experiment) -> None:
     """InputError naming the first commanded depth beyond the scene's range (the largest
-    domain, `simulator._depth_limit`, at the scene's parameters): every model run refuses it,
+    domain, `ContactSimulator._depth_limit`, at the scene's parameters): every model run refuses it,
     so the fit used to run into a wall of refused trials and report a secant that would not
     converge (0.8.0's outside tester); `replay` names the sample."""
     from viscoadh_ros.core.simulator import ContactSimulator

@@ -425,16 +425,7 @@ class _TimeStepped:
         self.rate = e_kelvin / eta_kelvin if e_kelvin.size else np.zeros(0)
         self.p, self.p_inv, self.lam, self.beta = _modal_chain(physics.e0, e_kelvin, eta_kelvin)
         self.punch_radius = getattr(physics.profile, "punch_radius", None)
-        if numerics.domain_radius > 0.0:
-            self.initial_length = numerics.domain_radius
-        elif self.punch_radius is not None:
-            self.initial_length = self.punch_radius
-        elif physics.work_of_adhesion > 0.0:
-            self.initial_length = 2.0 * physics.adhesion_length()
-        else:
-            self.initial_length = 0.0  # chosen from the depth at first contact
-        if self.punch_radius is not None:
-            self.initial_length = min(self.initial_length, self.punch_radius)
+        self.initial_length = _first_domain(physics, numerics)
         if numerics.domain_radius <= 0.0 and not self.initial_length <= FIRST_DOMAIN_LIMIT:
             # A profile that rises slower than the adhesive neck (a power law with exponent
             # <= 0.5 and a tiny coefficient): the neck radius search ran to 1e300 m and the
@@ -632,7 +623,7 @@ class _TimeStepped:
         span = min(length, reach)
         prepared = self._prepared
         if prepared is None or prepared[0] != length:
-            if length > max(1e6 * self.initial_length, 1e3):
+            if length > _largest_domain(self.initial_length):
                 self._prepare_radius = math.inf
                 return
             m = self._fine_index.shape[0]
@@ -717,7 +708,7 @@ class _TimeStepped:
             self.row = target
             return
         length = row.length * self.numerics.growth_factor
-        limit = max(1e6 * self.initial_length, 1e3)
+        limit = _largest_domain(self.initial_length)
         if length > limit:
             raise InputError(self._unrepresentable(limit))
         reach = self.punch_radius if self.punch_radius is not None else math.inf
@@ -1170,20 +1161,25 @@ FIRST_DOMAIN_LIMIT = 1e3
 MIN_TIME_STEP = 1e-300
 
 
-def _depth_limit(physics: Any, numerics: Any) -> float:
-    """|depth| a step may reach, m: the largest domain `_TimeStepped._grow` lets a contact of
-    this scene reach (1e6 x its first domain, at least 1e3 m). Beyond it a flat punch took
-    1.9e11 m under 1e15 N and answered the next 0.01 N with 0.13 N (the memory's rounding at
-    that scale), and the closed form took 1e10 m."""
-    initial = float(numerics.domain_radius)  # as `_TimeStepped` picks its first domain
+def _first_domain(physics: Any, numerics: Any) -> float:
+    """The first domain's length of a time-stepped contact, m: `numerics.domain_radius`, else
+    the punch radius, else twice the adhesive neck radius, else 0 (chosen from the depth at
+    first contact); never longer than a punch."""
     punch = getattr(physics.profile, "punch_radius", None)
-    if initial <= 0.0 and punch is not None:
-        initial = float(punch)
-    elif initial <= 0.0 and physics.work_of_adhesion > 0.0:
-        initial = 2.0 * physics.adhesion_length()
-    if punch is not None:
-        initial = min(initial, float(punch))
-    return max(1e6 * initial, 1e3)
+    if numerics.domain_radius > 0.0:
+        first = numerics.domain_radius
+    elif punch is not None:
+        first = punch
+    elif physics.work_of_adhesion > 0.0:
+        first = 2.0 * physics.adhesion_length()
+    else:
+        first = 0.0
+    return min(first, punch) if punch is not None else first
+
+
+def _largest_domain(first: float) -> float:
+    """The longest domain a contact whose first domain is `first` m long may grow to, m."""
+    return max(1e6 * first, 1e3)
 
 
 def _beyond_depth_limit(depth: float, limit: float) -> InputError:
@@ -1390,7 +1386,14 @@ class ContactSimulator:
         # The deepest |depth| a step may reach, m: the largest domain a time-stepped contact
         # of this scene can represent (`_TimeStepped._grow`), on every model (a flat punch,
         # whose contact radius is fixed, and the closed forms have no domain to outgrow).
-        self._depth_limit = _depth_limit(self.physics, self.numerics)
+        # Beyond it a flat punch took 1.9e11 m under 1e15 N and answered the next 0.01 N with
+        # 0.13 N (the memory's rounding at that scale), and the closed form took 1e10 m.
+        model = self._model
+        if isinstance(model, _TimeStepped):
+            first = model.initial_length
+        else:
+            first = _first_domain(self.physics, self.numerics)
+        self._depth_limit = _largest_domain(first)
         # The physics constants the compiled step derives its outputs from (`_STEP`).
         self._e_relaxed = float(self.physics.e_relaxed)
         self._v_c1, self._v_c2 = (float(v) for v in self.physics.critical_speeds)
@@ -1721,10 +1724,11 @@ class ContactSimulator:
         branch (the path prediction and `_predicted_root`'s secant trials) with `_trial`,
         `advance`, `rewind` and `_publish` in this one frame and the kernel deriving the
         outputs (`_STEP`, as the lean depth path): the general path's trials, outputs, memo
-        and state bit for bit (tests/test_step_lean.py). None, with nothing changed, when
-        that branch does not apply or does not find the root (a trial detached, a slope
-        unlike the last, a step the domain cannot hold): the general path then runs the
-        step from the start (the same trials again, 0.2 % of the default scene's rows)."""
+        and state bit for bit (tests/test_step_lean.py). A prediction that does not hold (a
+        trial detached, a slope unlike the last, no convergence) goes on into `_search_force`
+        from the same trials, as `_solve_force` does. None, with nothing changed, when that
+        branch does not apply (no valid prediction, bad input) or a trial needs a larger
+        domain: the general path then runs the step from the start."""
         if not (
             t - t == 0.0 and target - target == 0.0 and (t == self._time or t - self._time >= MIN_TIME_STEP)
         ):
@@ -1993,7 +1997,7 @@ class ContactSimulator:
         # batch may be another one, or none: a batch that ended idle read every edge at rest
         # as moving, INDENTING and DETACHING in turn).
         r0 = np.concatenate(([self._output.contact_radius], radius[:-1]))
-        dt = np.diff(t, prepend=self._time)
+        dt = steps
         energy_input = np.cumsum(np.concatenate(([self._energy_input], work)))[1:]
         bad = np.flatnonzero(~(np.isfinite(energy_input) & np.isfinite(dissipated)))
         if bad.size:
