@@ -167,6 +167,8 @@ def advance_from_reference(
             e_kelvin,
             e0,
             c_crit,
+            gf,
+            df,
         )
         force_new = _force(new_a, d1, wsum, bsum, dx, g_c, gf, gint, df, e0, kap, wsum[:0])
         out[OUT_RADIUS] = new_a
@@ -302,6 +304,8 @@ def advance_from_reference(
             e_kelvin,
             e0,
             c_crit,
+            gf,
+            df,
         )
         if k_count:
             # ... the window (retimed where the edge crossed), then the elements after it.

@@ -4,7 +4,13 @@
 `tests/data/kernel_golden.npz`, written by the 0.2.0 kernel (main before the windowed trials),
 then again by the 0.4.0 kernel whose snap-in out of contact is located in time directly
 (`_kernels._touch_time`: a new substep partition around the touch changes the bits from a
-snap-in on; benchmarks/rounds/0.4.0-snap.md states by how much against the 0.2.0 file)::
+snap-in on; benchmarks/rounds/0.4.0-snap.md states by how much against the 0.2.0 file), and
+by the 0.9.0 kernel, which locates a let-go in time even when the edge moves less than the
+edge limit on its way to no contact, and takes the loss of a let-go from a contact at most
+`_kernels.FOLD_FINE_CELLS` elements wide on the fine profile (`_kernels._fold_energy`): against
+the 0.8.0 file one random-memory row moved (K = 1 rough memory: force 7.7e-5, radius 8.8e-5,
+work 3.2e-4 of their largest values), every other output by at most 1.5e-13 (rounding the
+0.8.0 file already differed by, within `golden_tolerance.RELATIVE`)::
 
     .venv/bin/python tests/kernel_golden.py <checkout root of the reference> tests/data/kernel_golden.npz
 

@@ -12,7 +12,7 @@ import pytest
 from scenes import one_contact
 
 from viscoadh_ros.core import reference
-from viscoadh_ros.core.config import SceneConfig
+from viscoadh_ros.core.config import SceneConfig, default_scene_path
 from viscoadh_ros.core.criterion import (
     critical_edge_speeds,
     scale_separation_holds,
@@ -223,6 +223,71 @@ def test_predict_pull_off_catches_the_largest_pull_between_its_rows() -> None:
     t = np.linspace(0.0, 1.5 * prediction.time_to_detach, rows + 1)[1:]
     done = sim.step_depths(sim.time + t, depth - speed * t)["force"].min()
     assert abs(prediction.pull_off_force - done) <= 1e-3 * abs(done), (prediction.pull_off_force, done)
+
+
+def _fine_retraction(sim: ContactSimulator, speed: float, duration: float, rows: int) -> tuple[float, float]:
+    """The most tensile force and the first detached row's time (s after now) of the same
+    constant-speed retraction stepped in `rows` rows over `duration` s, on a copy."""
+    copy = sim.snapshot()
+    t = np.linspace(0.0, duration, rows + 1)[1:]
+    out = sim.step_depths(sim.time + t, sim.output.depth - speed * t)
+    sim.restore(copy)
+    gone = np.flatnonzero(out["contact_radius"] <= 0.0)
+    return float(out["force"].min()), float(t[gone[0]]) if gone.size else math.nan
+
+
+@pytest.mark.parametrize(
+    ("indenter", "kelvin", "viscosities", "depth", "model"),
+    [
+        # A deep press of a blunt cone: the prediction's rows (1/400 of the depth) were wider
+        # than the whole adhesive branch, so no row was tensile: 0 N (outside tester, 0.8.0).
+        ({"shape": "cone", "half_angle": math.radians(85.0)}, (), (), 1e-3, "closed_form"),
+        ({"shape": "cone", "half_angle": math.radians(85.0)}, (5e4,), (1e9,), 1e-3, "time_stepped"),
+        # A glassy pad (G0 / G1 = 1e4, creep time 1e6 s) pressed 5 um: the rows' range scales
+        # with E0* / E_r*, so the first row already let go: 0 N and a detach time 16x late.
+        ({"shape": "sphere", "radius": 5e-3}, (1e2,), (1e8,), 5e-6, "time_stepped"),
+    ],
+    ids=["deep cone closed form", "deep cone glassy", "glassy sphere"],
+)
+def test_predict_pull_off_finds_a_branch_narrower_than_its_rows(indenter, kelvin, viscosities, depth, model) -> None:
+    """The model path is forced (`model`) so each case runs the path it names. Against the
+    same retraction stepped in 400,000 rows: the pull-off within 1e-3 of itself and the let-go
+    within 1e-4 of the time retracted."""
+    contact = one_contact(
+        indenter,
+        glass_shear_modulus=1e6,
+        kelvin=kelvin,
+        viscosities=viscosities,
+        work=0.05,
+        numerics={"model": model},
+    )
+    sim = ContactSimulator(contact)
+    sim.step(0.01, depth=depth)
+    assert sim.model == model
+    speed = 1e-3
+    prediction = predict_pull_off(sim, retract_speed=speed)
+    force, gone = _fine_retraction(sim, speed, (depth + 2e-5) / speed, 400_000)
+    assert prediction.detached
+    assert force < 0.0
+    assert abs(prediction.pull_off_force - force) <= 1e-3 * abs(force), (prediction.pull_off_force, force)
+    assert abs(prediction.time_to_detach - gone) <= 1e-4 * gone, (prediction.time_to_detach, gone)
+
+
+@pytest.mark.parametrize(("press", "hold", "speed"), [(50e-6, 0.2, 2e-3), (5e-6, 0.5, 1e-4), (20e-6, 2.0, 1e-3)])
+def test_predict_pull_off_time_to_detach_is_the_let_go(press, hold, speed) -> None:
+    """`time_to_detach` was the end of the prediction's row that let go: 3-6 % late on the
+    default scene (outside tester, 0.8.0). Against the same retraction in rows 20,000 times
+    finer than the time it takes: within 1e-4 of it."""
+    contact = SceneConfig.from_yaml(default_scene_path()).contacts[0]
+    sim = ContactSimulator(contact)
+    times = 0.002 * np.arange(50)
+    sim.step_depths(times, np.linspace(-2e-6, press, 50))
+    sim.step(times[-1] + hold, depth=press)
+    prediction = predict_pull_off(sim, retract_speed=speed)
+    force, gone = _fine_retraction(sim, speed, 2.0 * prediction.time_to_detach, 40_000)
+    assert prediction.detached
+    assert abs(prediction.time_to_detach - gone) <= 1e-4 * gone, (prediction.time_to_detach, gone)
+    assert abs(prediction.pull_off_force - force) <= 1e-4 * abs(force), (prediction.pull_off_force, force)
 
 
 def test_force_control_creeps_under_constant_load() -> None:

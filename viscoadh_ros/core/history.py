@@ -23,8 +23,12 @@ FloatArray = NDArray[np.float64]
 PULL_OFF_STEPS = 400
 #: The retraction gives up after this many characteristic depth ranges.
 PULL_OFF_RANGES = 50
-#: Rows per output step across the two steps around the largest pull, looked at again.
+#: Rows per step across the two steps around the let-go (or the largest pull), looked at again.
 PULL_OFF_REFINE = 16
+#: The let-go is bracketed to this fraction of the time retracted (the zoom stops there) ...
+PULL_OFF_TIME_TOLERANCE = 1e-6
+#: ... or after this many zoom levels (each narrows the bracket 16 times).
+PULL_OFF_LEVELS = 8
 
 
 @dataclass(frozen=True)
@@ -147,7 +151,15 @@ def predict_pull_off(simulator: ContactSimulator, retract_speed: float) -> PullO
 
     The depth step is 1/PULL_OFF_STEPS of a characteristic range (current depth plus the
     profile height at the edge plus the glass critical elongation scaled to the relaxed
-    modulus); the run stops after PULL_OFF_RANGES such ranges and says so.
+    modulus); the run stops after PULL_OFF_RANGES such ranges and says so. That range can be
+    far wider than the adhesive branch (a deep press, a glassy body: E0*/E_r* >> 1), so one
+    step may cross the whole branch; the let-go is therefore bracketed and the bracket
+    zoomed: the same path (the depth is linear in time between rows whatever their spacing)
+    is stepped again from the row before the last attached one, PULL_OFF_REFINE rows per
+    step, until the first detached row is known to PULL_OFF_TIME_TOLERANCE of the time
+    retracted (`time_to_detach` is that row's time). The largest pull is the most tensile
+    force of every row run; the rows around it are then looked at again, PULL_OFF_REFINE
+    times finer, from the same rows before it.
     """
     speed = require_positive("retract_speed", retract_speed)
     start = simulator.snapshot()
@@ -163,33 +175,63 @@ def predict_pull_off(simulator: ContactSimulator, retract_speed: float) -> PullO
         span = radius
     dt = span / PULL_OFF_STEPS / speed
     t0, d0 = simulator.time, out.depth
-    best_force, best_depth = min(out.force, 0.0), out.depth
-    best = 0
-    detached = False
-    try:
-        for i in range(1, PULL_OFF_STEPS * PULL_OFF_RANGES + 1):
-            step = simulator.step(t0 + i * dt, depth=d0 - speed * i * dt)
-            if step.force < best_force:
-                best_force, best_depth, best = step.force, step.depth, i
+    # The largest pull: force, depth, time after t0 (-1: none yet) and the level of rows it
+    # came from (`levels`: each level's starting snapshot, its time and its row spacing).
+    best = [min(out.force, 0.0), out.depth, -1.0, 0]
+    levels: list[tuple[Any, float, float]] = [(start, 0.0, dt)]
+
+    def rows_from(level: int, count: int, skip: int = 0) -> int:
+        """`count` rows of level `level` after its first `skip` rows; the first detached
+        row's index (1-based), 0 if none."""
+        origin, ta, h = levels[level]
+        simulator.restore(origin)
+        for k in range(1, skip + count + 1):
+            t = ta + k * h
+            step = simulator.step(t0 + t, depth=d0 - speed * t)
+            if step.force < best[0]:
+                best[:] = [step.force, step.depth, t, level]
             if not simulator.in_contact:
-                detached = True
-                break
+                return k
+        return 0
+
+    def level_after(level: int, rows: int, refine: int) -> int:
+        """A new level: from `rows` rows of `level` on, rows `refine` times finer."""
+        origin, ta, h = levels[level]
+        if rows:
+            rows_from(level, rows)
+            origin = simulator.snapshot()
+        levels.append((origin, ta + rows * h, h / refine))
+        return len(levels) - 1
+
+    detached = False
+    elapsed = 0.0
+    try:
+        first = rows_from(0, PULL_OFF_STEPS * PULL_OFF_RANGES)
         elapsed = simulator.time - t0
-        if best > 0:
-            # The largest pull lies within a step of the best sample; at a fast retraction it
-            # is the last row before the jump, a cusp a coarse row steps past (0.9 % of the
-            # pull-off at 1 d_c, 10 mm/s). The same path again to the row before it, then
-            # PULL_OFF_REFINE rows per step across the two steps around it.
-            simulator.restore(start)
-            for i in range(1, best):
-                simulator.step(t0 + i * dt, depth=d0 - speed * i * dt)
-            for k in range((best - 1) * PULL_OFF_REFINE + 1, (best + 1) * PULL_OFF_REFINE + 1):
-                t = k * dt / PULL_OFF_REFINE
-                step = simulator.step(t0 + t, depth=d0 - speed * t)
-                if step.force < best_force:
-                    best_force, best_depth = step.force, step.depth
-                if not simulator.in_contact:
+        if first:
+            detached = True
+            # The let-go lies within the last two rows: zoom in from the row before the last
+            # attached one, rows PULL_OFF_REFINE times finer, until the first detached row is
+            # known closely enough.
+            level, count = 0, first
+            for _ in range(PULL_OFF_LEVELS):
+                level = level_after(level, max(count - 2, 0), PULL_OFF_REFINE)
+                count = rows_from(level, 4 * PULL_OFF_REFINE)
+                if not count:
+                    # The finer rows hold on a little longer than the coarser ones let go:
+                    # keep the bracket found so far.
                     break
+                _, ta, h = levels[level]
+                elapsed = ta + count * h
+                if h <= PULL_OFF_TIME_TOLERANCE * elapsed:
+                    break
+        if best[2] > 0.0:
+            # The rows around the largest pull again, PULL_OFF_REFINE times finer: a smooth
+            # minimum, or the cusp at a fast let-go that a row steps past (0.9 % of the
+            # pull-off at 1 d_c, 10 mm/s).
+            _, ta, h = levels[best[3]]
+            k = int(round((best[2] - ta) / h))
+            rows_from(level_after(best[3], max(k - 1, 0), PULL_OFF_REFINE), 2 * PULL_OFF_REFINE)
     finally:
         simulator.restore(start)
     if detached:
@@ -199,7 +241,7 @@ def predict_pull_off(simulator: ContactSimulator, retract_speed: float) -> PullO
             f"still in contact after retracting {speed * elapsed:.6g} m "
             f"({PULL_OFF_RANGES} characteristic depth ranges); the values are up to there"
         )
-    return PullOffPrediction(best_force, best_depth, elapsed, detached, message)
+    return PullOffPrediction(best[0], best[1], elapsed, detached, message)
 
 
 def _samples(count: int) -> str:

@@ -2091,7 +2091,11 @@ class ContactSimulator:
         energy_input: float,
     ) -> StepOutput:
         physics = self.physics
-        dissipated = self._model.energy_dissipated(energy_input, depth)
+        # Never below the last published value: the closed form's input minus potential is
+        # exact but rounded, and fell by ~1e-24 J (5e-16 of it) on a force-controlled branch,
+        # or below zero after a large excursion (outside testers, 0.8.0). The time-stepped
+        # model's running sum never decreases, so this changes nothing there.
+        dissipated = max(self._model.energy_dissipated(energy_input, depth), self._output.energy_dissipated)
         if not (math.isfinite(energy_input) and math.isfinite(dissipated)):
             raise _overflow(energy_input, dissipated)
         g_edge = self._model.edge_height(radius) if radius > 0.0 else 0.0
