@@ -39,6 +39,7 @@ the counters then count from the node's start.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import re
 import time as wallclock
@@ -625,7 +626,7 @@ class ModelRun:
         return [StepOutput(*values) for values in zip(*columns, strict=True)]
 
 
-def _contact_of(restart: Restart, contact_id: str) -> ContactConfig:
+def changed_contact(restart: Restart, contact_id: str) -> ContactConfig:
     """The configuration a PARAMETERS event carries for ``contact_id``."""
     import yaml
 
@@ -662,22 +663,9 @@ def run_model(
     """
     from viscoadh_ros.core.simulator import STEP_OUTPUT_FIELDS
 
-    n, m, r = experiment.input_ns.size, experiment.measured_ns.size, len(experiment.restarts)
+    n, m = experiment.input_ns.size, experiment.measured_ns.size
     restarts = experiment.restarts
-    kind = np.concatenate([np.zeros(n, np.int8), np.ones(m, np.int8), np.full(r, 2, np.int8)])
-    index = np.concatenate([np.arange(n), np.arange(m), np.arange(r)])
-    stamps = np.concatenate(
-        [experiment.input_ns, experiment.measured_ns, np.array([x.ns for x in restarts], dtype=np.int64)]
-    )
-    orders = np.concatenate(
-        [experiment.input_order, experiment.measured_order, np.array([x.order for x in restarts], np.int64)]
-    )
-    if experiment.by_arrival:
-        sequence = np.argsort(orders, kind="stable")
-    else:
-        # By stamp; at equal stamps in recording order (see the module docstring).
-        sequence = np.lexsort((orders, stamps))
-    kind, index, stamps = kind[sequence], index[sequence], stamps[sequence]
+    kind, index, stamps = _run_order(experiment)
 
     columns = {name: np.empty(n, dtype=dtype) for name, dtype in _column_dtypes(STEP_OUTPUT_FIELDS).items()}
     ran: list[tuple[NDArray[np.int64], str]] = []  # (inputs, the model they ran with) per piece
@@ -688,7 +676,7 @@ def run_model(
     cuts = np.flatnonzero(kind == 2)
     for lo, hi in zip(np.concatenate(([0], cuts + 1)), np.concatenate((cuts, [kind.size])), strict=True):
         if lo > 0 and parameters and restarts[int(index[lo - 1])].kind == PARAMETERS:
-            contact = _contact_of(restarts[int(index[lo - 1])], contact.id)
+            contact = changed_contact(restarts[int(index[lo - 1])], contact.id)
         inputs = np.flatnonzero(kind[lo:hi] == 0)
         first = lo + int(inputs[0]) if inputs.size else hi
         if first > lo:
@@ -715,6 +703,59 @@ def run_model(
         for inputs, model in ran:
             input_model[inputs] = model
     return ModelRun(columns, model_force, wall_time, ran[0][1], input_model)
+
+
+def _run_order(experiment: Experiment) -> tuple[NDArray[np.int8], NDArray[np.int64], NDArray[np.int64]]:
+    """``(kind, index, stamp_ns)`` of every event in the order the model runs them: kind 0 an
+    input, 1 a measured sample, 2 a restart; index its position among those of its kind."""
+    n, m, r = experiment.input_ns.size, experiment.measured_ns.size, len(experiment.restarts)
+    restarts = experiment.restarts
+    kind = np.concatenate([np.zeros(n, np.int8), np.ones(m, np.int8), np.full(r, 2, np.int8)])
+    index = np.concatenate([np.arange(n), np.arange(m), np.arange(r)])
+    stamps = np.concatenate(
+        [experiment.input_ns, experiment.measured_ns, np.array([x.ns for x in restarts], dtype=np.int64)]
+    )
+    orders = np.concatenate(
+        [experiment.input_order, experiment.measured_order, np.array([x.order for x in restarts], np.int64)]
+    )
+    if experiment.by_arrival:
+        sequence = np.argsort(orders, kind="stable")
+    else:
+        # By stamp; at equal stamps in recording order (see the module docstring).
+        sequence = np.lexsort((orders, stamps))
+    return kind[sequence], index[sequence], stamps[sequence]
+
+
+def stretch(experiment: Experiment, after: int | None, before: int | None) -> Experiment:
+    """The part of a node log recorded after position ``after`` and before ``before`` (None:
+    from its start, to its end), cut at restarts so it runs as the whole record runs there:
+    the inputs between them, the measured samples from the first of those inputs on (those
+    before it are the contact at rest), the restarts between. ``t0_ns`` stays the record's, so
+    times still count from its first input; ``rejected_index`` and ``commands_before`` stay
+    too (they count the commands received, not the inputs run). InputError when no input is
+    left."""
+    low = -1 if after is None else after
+    high = np.iinfo(np.int64).max if before is None else before
+    inputs = (experiment.input_order > low) & (experiment.input_order < high)
+    if not inputs.any():
+        raise InputError(f"{experiment.input_topic}: no input between the record's restarts there")
+    measured = experiment.measured_order < high
+    if experiment.by_arrival:
+        measured &= experiment.measured_order > int(experiment.input_order[inputs].min())
+    else:
+        measured &= experiment.measured_ns >= int(experiment.input_ns[inputs].min())
+    return dataclasses.replace(
+        experiment,
+        input_ns=experiment.input_ns[inputs],
+        input_order=experiment.input_order[inputs],
+        input_mode=experiment.input_mode[inputs],
+        input_value=experiment.input_value[inputs],
+        input_index=None if experiment.input_index is None else experiment.input_index[inputs],
+        measured_ns=experiment.measured_ns[measured],
+        measured_force=experiment.measured_force[measured],
+        measured_order=experiment.measured_order[measured],
+        restarts=tuple(r for r in experiment.restarts if low < r.order < high),
+    )
 
 
 def _at_rest(contact: ContactConfig, index: NDArray[np.int64], model_force: NDArray[np.float64]) -> None:

@@ -87,7 +87,7 @@ def write_report(
 
     figure_path, table_path = report_paths(output)
     text = table(result, title)
-    run = run_model(result.model_contact, experiment)
+    run = run_model(result.model_contact, experiment, parameters=False)  # as the fit ran it
     t = experiment.time(experiment.measured_ns)
     measured, model, used = experiment.measured_force, run.model_force, result.used
     depth = _depth_at(experiment, experiment.measured_ns)
