@@ -3,7 +3,7 @@
 The node (in process, simulated clock, logging on) runs the standard-solid sphere through four
 press-pull cycles: two with the work of adhesion 0.05 J/m^2 (a `C/reset` between them), then a
 parameter change to 0.08 (a PARAMETERS event), two more cycles (a reset between them). After
-each reset and the change the contact idles for 2.5 s of node clock, so the hold timer logs
+each reset and the change the contact idles for 8 s of node clock, so the hold timer logs
 states of the contact at rest. An outside tester fitted the cycles after the change only
 (`--time-range`) and got "RMSE 0 N, r^2 1.000000", the work of adhesion NOT IDENTIFIED "(best
 0.05)" and a scene saying 0.05: the fit ran the model with the logged 0.08 after the change
@@ -78,15 +78,16 @@ def node_log(tmp_path_factory: pytest.TempPathFactory) -> Path:
                 driver.command(start + t, DEPTHS[-1])
 
         def idle(start: float) -> None:
-            """2.5 s of node clock with no command: the hold timer logs the contact at rest."""
-            for t in np.arange(start, start + 2.5, 0.1):
+            """8 s of node clock with no command: the hold timer logs the contact at rest (once
+            a second, more samples than the jump mask of the next snap-in covers)."""
+            for t in np.arange(start, start + 8.0, 0.25):
                 move_clock(float(t))
 
         move_clock(1.0)
         cycle(1.0)
         assert _call(reset, Trigger.Request()).success
         idle(2.1)
-        cycle(5.0)
+        cycle(11.0)
         change = SetParameters.Request(
             parameters=[
                 ParameterMsg(
@@ -97,11 +98,11 @@ def node_log(tmp_path_factory: pytest.TempPathFactory) -> Path:
         )
         result = _call(parameters, change).results[0]
         assert result.successful, result.reason
-        idle(6.1)
-        cycle(9.0)
+        idle(12.1)
+        cycle(21.0)
         assert _call(reset, Trigger.Request()).success
-        idle(10.1)
-        cycle(13.0)
+        idle(22.1)
+        cycle(31.0)
     return log
 
 
@@ -110,6 +111,14 @@ def _change_time(log: Path) -> float:
     experiment = load_experiment(Bag(log), contact="finger")
     assert [r.kind for r in experiment.restarts] == [RESET, PARAMETERS, RESET]
     return float(experiment.time(np.array([experiment.restarts[1].ns]))[0])
+
+
+def _at_rest(experiment: Any) -> np.ndarray:
+    """The measured samples logged after a reset and before the next command."""
+    (reset,) = experiment.restarts
+    assert reset.kind == RESET
+    next_command = experiment.input_order[experiment.input_order > reset.order].min()
+    return (experiment.measured_order > reset.order) & (experiment.measured_order < next_command)
 
 
 def test_a_fit_across_the_parameter_change_is_refused(node_log: Path, tmp_path: Path, capsys: Any) -> None:
@@ -135,15 +144,24 @@ def test_a_fit_after_the_change_fits_the_new_material(node_log: Path, tmp_path: 
     # Within 1 %: the log is noiseless and the fit's grid is not the node's (model error).
     fitted = SceneConfig.from_yaml(out).contact("finger")
     assert fitted.adhesion.work_of_adhesion == pytest.approx(0.08, rel=1e-2), fitted
+
+    # What was fitted: the samples of the stretch after the change whose model depends on the
+    # trial, not those of the contact at rest after the second reset.
     done = fit_bag(str(node_log), {"free": "work_of_adhesion", "time_range": [change + 0.01, 100.0]})
-    assert done.result.values["work_of_adhesion"] == pytest.approx(0.08, rel=1e-2)
-    assert done.result.rmse > 0.0, "a fit never reports samples its trial cannot change"
-    assert [r.kind for r in done.experiment.restarts] == [RESET], "the stretch after the change"
+    experiment, result = done.experiment, done.result
+    assert result.values["work_of_adhesion"] == pytest.approx(0.08, rel=1e-2)
+    assert result.rmse > 0.0, "a fit never reports samples its trial cannot change"
+    at_rest = _at_rest(experiment)
+    assert at_rest.sum() >= 6, "the session logs the contact at rest"
+    assert not np.any(result.used & at_rest)
 
 
 def test_a_fit_before_the_change_fits_the_first_material(node_log: Path) -> None:
     """The other side: the scene the node started with, the cycles before the change."""
     change = _change_time(node_log)
     done = fit_bag(str(node_log), {"free": "work_of_adhesion", "time_range": [0.0, change - 0.01]})
-    assert done.result.values["work_of_adhesion"] == pytest.approx(0.05, rel=1e-2)
-    assert [r.kind for r in done.experiment.restarts] == [RESET], "the stretch before the change"
+    experiment, result = done.experiment, done.result
+    assert result.values["work_of_adhesion"] == pytest.approx(0.05, rel=1e-2)
+    at_rest = _at_rest(experiment)
+    assert at_rest.sum() >= 6, "the session logs the contact at rest"
+    assert not np.any(result.used & at_rest)

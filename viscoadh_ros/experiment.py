@@ -726,6 +726,18 @@ def _run_order(experiment: Experiment) -> tuple[NDArray[np.int8], NDArray[np.int
     return kind[sequence], index[sequence], stamps[sequence]
 
 
+def at_rest(experiment: Experiment) -> NDArray[np.bool_]:
+    """(m,) True for the measured samples the model takes from a contact at rest: after a
+    restart (RESET, PARAMETERS) and before the next input, the node's hold timer publishes the
+    fresh contact's output (:func:`_at_rest`), whatever its material."""
+    kind, index, _ = _run_order(experiment)
+    last_input, last_restart = _last_true(kind == 0), _last_true(kind == 2)
+    resting = np.zeros(experiment.measured_ns.size, dtype=np.bool_)
+    measured = kind == 1
+    resting[index[measured]] = last_restart[measured] > last_input[measured]
+    return resting
+
+
 def stretch(experiment: Experiment, after: int | None, before: int | None) -> Experiment:
     """The part of a node log recorded after position ``after`` and before ``before`` (None:
     from its start, to its end), cut at restarts so it runs as the whole record runs there:

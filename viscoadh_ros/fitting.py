@@ -93,6 +93,7 @@ from viscoadh_ros.experiment import (
     PARAMETERS,
     Experiment,
     Restart,
+    at_rest,
     changed_contact,
     run_model,
     stretch,
@@ -1033,7 +1034,7 @@ def fitted_stretch(
     changes = [r for r in experiment.restarts if r.kind == PARAMETERS]
     if not changes:
         return experiment, None
-    selected = segment_samples(experiment, options)
+    selected = segment_samples(experiment, options) & ~at_rest(experiment)
     if not selected.any():
         return experiment, None
     side = _parameter_side(experiment, selected, contact)
@@ -1058,7 +1059,7 @@ def fit(
     identified with its interval (`FitResult.identified`). The trial parameters run throughout
     the record (a PARAMETERS event restarts the contact with them), so the samples fitted must
     lie on one side of every parameter change (FitError otherwise; `fitted_stretch` cuts the
-    record to that side).
+    record to that side); samples of a contact at rest after a restart are not fitted.
     """
     started = wallclock.perf_counter()
     options = options or FitOptions()
@@ -1080,7 +1081,9 @@ def fit(
     depth = np.interp(
         experiment.time(experiment.measured_ns), experiment.time(experiment.input_ns), experiment.input_value
     )
-    selected = segment_samples(experiment, options)
+    # Samples of the contact at rest after a restart (before its next input) are the fresh
+    # contact's output whatever the material: nothing to fit.
+    selected = segment_samples(experiment, options) & ~at_rest(experiment)
     _parameter_side(experiment, selected, contact)
     smooth = _widen(smooth_samples(experiment.measured_force, noise, depth), JUMP_WINDOW)
     used = smooth & selected
