@@ -28,14 +28,24 @@ Two orders of events:
   configuration it carries), and the next accepted command starts a new time base, as in the
   node.
 - Any other recording runs by stamp; at equal stamps in recording order.
+
+A record must hold the contact's history from its start: when the contact's logged
+ContactStates (``C/state``) count commands the node received before the record's first one
+(a later file of a rotated log, a recording started late), and no RESET or PARAMETERS event
+comes before that command, :func:`load_experiment` refuses it (a fresh contact there is not
+the node's). After such a restart the record replays exactly; the events' command indexes and
+the counters then count from the node's start.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
+import re
 import time as wallclock
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -101,6 +111,11 @@ class Experiment:
     rejected_reason: tuple[str, ...] = ()
     restarts: tuple[Restart, ...] = ()  # RESET / PARAMETERS events, in recording order
     events_topic: str | None = None
+    #: Commands the contact had received (accepted and rejected) before the record's first
+    #: one, and how many of them the node rejected: a record that starts with a reset of a
+    #: contact the node had driven before (the node counts commands since it started).
+    commands_before: int = 0
+    rejected_before: int = 0
 
     def time(self, ns: NDArray[np.int64]) -> NDArray[np.float64]:
         """Seconds since the first input."""
@@ -119,10 +134,12 @@ class Experiment:
     @property
     def counters(self) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
         """``(commands_received, commands_rejected)`` at each accepted input, as the node's
-        ContactState counts them (accepted so far including this one; refused so far)."""
+        ContactState counts them since it started (accepted so far including this one; refused
+        so far)."""
         index = self.input_index if self.input_index is not None else np.arange(self.input_ns.size)
-        received = np.arange(1, self.input_ns.size + 1)
-        rejected = np.searchsorted(np.sort(self.rejected_index), index)
+        accepted_before = self.commands_before - self.rejected_before
+        received = accepted_before + np.arange(1, self.input_ns.size + 1)
+        rejected = self.rejected_before + np.searchsorted(np.sort(self.rejected_index), index)
         return received, rejected.astype(np.int64)
 
 
@@ -142,21 +159,22 @@ def _field(msg: Any, path: str) -> Any:
     return msg
 
 
-def _read_topic(bag: Bag, topic: str) -> tuple[NDArray[np.int64], NDArray[np.int64], dict[str, NDArray]]:
+def _read_topic(
+    bag: Bag, topic: str, fields: tuple[str, ...] | None = None
+) -> tuple[NDArray[np.int64], NDArray[np.int64], dict[str, NDArray]]:
     """``(stamp_ns, order, columns)`` of ``topic``: the time of each message (header stamp, or
     the log time for a zero stamp or no header), its position in the recording, and the
-    :data:`_VALUE_FIELDS` of its type as arrays. Fixed-layout CDR is read in bulk; anything
-    else message by message through rclpy."""
+    ``fields`` (default: the :data:`_VALUE_FIELDS` of its type) as arrays. Fixed-layout CDR
+    is read in bulk; anything else message by message through rclpy."""
     type_name = bag.topics[topic]
+    fields = _VALUE_FIELDS[type_name] if fields is None else fields
     log_ns, order, rows = bag.rows(topic)
-    columns = None if rows is None else cdr.decode(type_name, rows, _VALUE_FIELDS[type_name])
+    columns = None if rows is None else cdr.decode(type_name, rows, fields)
     if columns is None:
         messages = list(bag.messages([topic]))
         log_ns = np.array([m.log_time_ns for m in messages], dtype=np.int64)
         order = np.array([m.order for m in messages], dtype=np.int64)
-        columns = {
-            path: np.array([_field(m.msg, path) for m in messages]) for path in _VALUE_FIELDS[type_name]
-        }
+        columns = {path: np.array([_field(m.msg, path) for m in messages]) for path in fields}
         if messages and hasattr(messages[0].msg, "header"):
             columns["stamp_ns"] = np.array(
                 [m.msg.header.stamp.sec * 1_000_000_000 + m.msg.header.stamp.nanosec for m in messages],
@@ -261,17 +279,29 @@ def load_experiment(
         bag.software_version is not None or _events_topic(inputs) in bag.topics
     )
     events_topic, restarts = None, ()
+    # What the node had counted before the record (a record that starts mid-history).
+    counts = _state_counts(bag, inputs) if bag.topics[inputs] == COMMAND else None
+    earlier, shown_by = _commands_before(counts, order)
+    rejected_before = 0
     if by_arrival:
         _refuse_hand_driven(bag, inputs)
-        events_topic, restarts, refused = _node_events(bag, inputs, stamps, order, columns)
+        events_topic, restarts, rejections = _node_events(bag, inputs)
+        _refuse_mid_history(bag, inputs, order, earlier, restarts)
+        refused = _refused_commands(events_topic, inputs, rejections, stamps, order, columns, earlier)
         keep, index, rejected, reasons = _node_verdicts(stamps, order, mode, value, refused, restarts)
         if not keep.any():
             raise InputError(f"input topic {inputs!r}: the node refused every command ({reasons[0]})")
+        if earlier and counts is not None:
+            # Of the earlier commands, those the node rejected: the state's count less the
+            # rejections recorded before it.
+            logged = int(np.count_nonzero(~keep & (order < counts.order[shown_by])))
+            rejected_before = min(max(int(counts.rejected[shown_by]) - logged, 0), earlier)
         # Recording order is the order the node handled them in.
         run = np.argsort(order, kind="stable")
         run = run[keep[run]]
         index = index[run]
     else:
+        _refuse_mid_history(bag, inputs, order, earlier, ())
         bad = np.flatnonzero((mode != DEPTH) & (mode != FORCE))
         if bad.size:
             raise InputError(f"{inputs}: IndentationCommand with unknown mode {mode[bad[0]]}")
@@ -320,6 +350,8 @@ def load_experiment(
         rejected_reason=reasons,
         restarts=restarts,
         events_topic=events_topic,
+        commands_before=earlier,
+        rejected_before=rejected_before,
     )
 
 
@@ -352,37 +384,115 @@ def _events_topic(inputs: str) -> str:
     return inputs.rsplit("/", 1)[0] + "/events"
 
 
-def _node_events(
-    bag: Bag,
-    inputs: str,
-    stamps: NDArray[np.int64],
-    order: NDArray[np.int64],
-    columns: dict[str, NDArray],
-) -> tuple[str | None, tuple[Restart, ...], dict[int, str]]:
-    """``(events topic, restarts, {command index: reason})`` from the ContactEvents logged
-    beside ``inputs``; an event that names a command the log does not hold is an error."""
+@dataclass(frozen=True)
+class _StateCounts:
+    """The counters of a contact's logged ContactStates (``C/state``): how many commands the
+    node had accepted and rejected on ``C/indentation`` since it started, at each state."""
+
+    order: NDArray[np.int64]  # positions of the states in the recording
+    received: NDArray[np.int64]  # commands_received (accepted)
+    rejected: NDArray[np.int64]  # commands_rejected
+
+
+def _state_counts(bag: Bag, inputs: str) -> _StateCounts | None:
+    """The counters of the ContactStates beside ``inputs`` (``C/state``), None when the
+    recording holds none."""
+    topic = inputs.rsplit("/", 1)[0] + "/state"
+    if bag.topics.get(topic) != cdr.CONTACT_STATE:
+        return None
+    _, order, columns = _read_topic(bag, topic, ("commands_received", "commands_rejected"))
+    if order.size == 0:
+        return None
+    return _StateCounts(
+        order.astype(np.int64),
+        columns["commands_received"].astype(np.int64),
+        columns["commands_rejected"].astype(np.int64),
+    )
+
+
+def _commands_before(counts: _StateCounts | None, order: NDArray[np.int64]) -> tuple[int, int]:
+    """``(commands, state)``: how many commands (accepted and rejected) the contact had
+    received before the first one the recording holds (``order``: the commands' positions),
+    and which state shows it; (0, -1) without states.
+
+    Each state counts every command the node handled up to it; the recording holds those
+    recorded before it: the difference is what came before the recording. Our recorder logs
+    a command before its answer, so it is the same at every state; another recorder (rosbag2)
+    may take a state before the command it answers, so the least over the states is taken."""
+    if counts is None:
+        return 0, -1
+    logged = np.searchsorted(np.sort(order), counts.order)
+    ahead = counts.received + counts.rejected - logged
+    state = int(np.argmin(ahead))
+    return max(int(ahead[state]), 0), state
+
+
+def _refuse_mid_history(
+    bag: Bag, inputs: str, order: NDArray[np.int64], earlier: int, restarts: tuple[Restart, ...]
+) -> None:
+    """An InputError when the record starts in the middle of the contact's history: the node
+    had received ``earlier`` commands before the first one recorded, and no RESET or
+    PARAMETERS event comes before that command. A replay would start a fresh contact there,
+    where the node's was pressed in, creeping or adhering (an outside tester's second file of
+    a rotated log: exit 0, an RMSE of 23 mN against the node's own forces). After a restart
+    the earlier history no longer matters: such a record replays exactly."""
+    if earlier <= 0 or (restarts and restarts[0].order < int(np.min(order))):
+        return
+    contact = inputs.strip("/").split("/")[-2] if inputs.strip("/").count("/") else inputs
+    raise InputError(
+        f"contact {contact!r}: {str(bag.path)!r} starts in the middle of the contact's history: the "
+        f"node had received {earlier} commands on {inputs!r} before the first one recorded here (its "
+        "ContactState counters say so) and no reset or parameter change of the contact comes "
+        "before that command, so a replay from rest there would not be the node's contact; "
+        + _whole_log_hint(bag.path)
+    )
+
+
+def _whole_log_hint(path: Path) -> str:
+    """What to replay instead of ``path``, a record that starts mid-history."""
+    if path.is_file():
+        if (path.parent / "metadata.yaml").is_file():
+            return f"replay the whole rosbag2 folder {str(path.parent)!r} instead (this is one of its files)"
+        rotated = re.fullmatch(r"(.+)_(\d+)\.mcap", path.name)
+        if rotated and int(rotated.group(2)) > 0:
+            stem = rotated.group(1)
+            return (
+                f"replay the whole log instead: put {stem}_0.mcap, {stem}_1.mcap, ... (a rotated log; "
+                f"this is file {rotated.group(2)}) in one folder and replay the folder (its files are "
+                "read in order)"
+            )
+    return (
+        "replay the whole log instead (the earlier files of a rotated log with this one, in one folder), "
+        "or a recording that starts before the contact's first command or with a reset of it (a "
+        "recorder that dropped messages leaves commands out too)"
+    )
+
+
+@dataclass(frozen=True)
+class _Rejection:
+    """A COMMAND_REJECTED event: the command's index since the node started, its stamp."""
+
+    index: int
+    stamp_ns: int
+    log_ns: int
+    reason: str
+
+
+def _node_events(bag: Bag, inputs: str) -> tuple[str | None, tuple[Restart, ...], list[_Rejection]]:
+    """``(events topic, restarts, rejections)`` from the ContactEvents logged beside ``inputs``."""
     topic = _events_topic(inputs)
     if topic not in bag.topics:
-        return None, (), {}
+        return None, (), []
     if bag.topics[topic] != EVENT:
         raise InputError(f"events topic {topic!r} has type {bag.topics[topic]!r}; expected {EVENT!r}")
-    # Commands in recording order: the node counts them in the order it received them.
-    received = np.argsort(order, kind="stable")
-    raw_stamp = columns.get("stamp_ns", stamps)[received]
     restarts: list[Restart] = []
-    refused: dict[int, str] = {}
+    rejections: list[_Rejection] = []
     for message in bag.messages([topic]):
         event = message.msg
         if event.kind == COMMAND_REJECTED:
-            k = int(event.command_index)
             stamp = event.command_stamp.sec * 1_000_000_000 + event.command_stamp.nanosec
-            if k >= received.size or int(raw_stamp[k]) != stamp:
-                raise InputError(
-                    f"{topic}: the event at {message.log_time_ns} ns rejects command {k} stamped "
-                    f"{stamp} ns, which {inputs!r} does not hold (it has {received.size} commands); "
-                    "the log is incomplete"
-                )
-            refused[k] = event.reason or "rejected by the node"
+            reason = event.reason or "rejected by the node"
+            rejections.append(_Rejection(int(event.command_index), stamp, message.log_time_ns, reason))
         elif event.kind in (RESET, PARAMETERS):
             if event.kind == PARAMETERS and not event.contact_yaml:
                 raise InputError(f"{topic}: PARAMETERS event at {message.log_time_ns} ns has no contact_yaml")
@@ -392,7 +502,38 @@ def _node_events(
             )
         else:
             raise InputError(f"{topic}: event of unknown kind {event.kind} at {message.log_time_ns} ns")
-    return topic, tuple(sorted(restarts, key=lambda r: r.order)), refused
+    return topic, tuple(sorted(restarts, key=lambda r: r.order)), rejections
+
+
+def _refused_commands(
+    topic: str | None,
+    inputs: str,
+    rejections: list[_Rejection],
+    stamps: NDArray[np.int64],
+    order: NDArray[np.int64],
+    columns: dict[str, NDArray],
+    earlier: int,
+) -> dict[int, str]:
+    """``{k: reason}``: the commands the events reject, by their index ``k`` among those the
+    recording holds (the event's index since the node started, less the ``earlier`` commands
+    before the recording); an event that names a command the recording does not hold is an
+    error."""
+    # Commands in recording order: the node counts them in the order it received them.
+    received = np.argsort(order, kind="stable")
+    raw_stamp = columns.get("stamp_ns", stamps)[received]
+    refused: dict[int, str] = {}
+    for rejection in rejections:
+        k = rejection.index - earlier
+        if not 0 <= k < received.size or int(raw_stamp[k]) != rejection.stamp_ns:
+            raise InputError(
+                f"{topic}: the event at {rejection.log_ns} ns rejects command {rejection.index} stamped "
+                f"{rejection.stamp_ns} ns, which {inputs!r} does not hold (it has {received.size} commands"
+                + (f" after {earlier} earlier ones" if earlier else "")
+                + "); the log is incomplete (a recorder that dropped messages, or a later file of a "
+                "rotated log without the contact's states)"
+            )
+        refused[k] = rejection.reason
+    return refused
 
 
 def _node_verdicts(
@@ -485,7 +626,7 @@ class ModelRun:
         return [StepOutput(*values) for values in zip(*columns, strict=True)]
 
 
-def _contact_of(restart: Restart, contact_id: str) -> ContactConfig:
+def changed_contact(restart: Restart, contact_id: str) -> ContactConfig:
     """The configuration a PARAMETERS event carries for ``contact_id``."""
     import yaml
 
@@ -522,22 +663,9 @@ def run_model(
     """
     from viscoadh_ros.core.simulator import STEP_OUTPUT_FIELDS
 
-    n, m, r = experiment.input_ns.size, experiment.measured_ns.size, len(experiment.restarts)
+    n, m = experiment.input_ns.size, experiment.measured_ns.size
     restarts = experiment.restarts
-    kind = np.concatenate([np.zeros(n, np.int8), np.ones(m, np.int8), np.full(r, 2, np.int8)])
-    index = np.concatenate([np.arange(n), np.arange(m), np.arange(r)])
-    stamps = np.concatenate(
-        [experiment.input_ns, experiment.measured_ns, np.array([x.ns for x in restarts], dtype=np.int64)]
-    )
-    orders = np.concatenate(
-        [experiment.input_order, experiment.measured_order, np.array([x.order for x in restarts], np.int64)]
-    )
-    if experiment.by_arrival:
-        sequence = np.argsort(orders, kind="stable")
-    else:
-        # By stamp; at equal stamps in recording order (see the module docstring).
-        sequence = np.lexsort((orders, stamps))
-    kind, index, stamps = kind[sequence], index[sequence], stamps[sequence]
+    kind, index, stamps = _run_order(experiment)
 
     columns = {name: np.empty(n, dtype=dtype) for name, dtype in _column_dtypes(STEP_OUTPUT_FIELDS).items()}
     ran: list[tuple[NDArray[np.int64], str]] = []  # (inputs, the model they ran with) per piece
@@ -548,7 +676,7 @@ def run_model(
     cuts = np.flatnonzero(kind == 2)
     for lo, hi in zip(np.concatenate(([0], cuts + 1)), np.concatenate((cuts, [kind.size])), strict=True):
         if lo > 0 and parameters and restarts[int(index[lo - 1])].kind == PARAMETERS:
-            contact = _contact_of(restarts[int(index[lo - 1])], contact.id)
+            contact = changed_contact(restarts[int(index[lo - 1])], contact.id)
         inputs = np.flatnonzero(kind[lo:hi] == 0)
         first = lo + int(inputs[0]) if inputs.size else hi
         if first > lo:
@@ -575,6 +703,71 @@ def run_model(
         for inputs, model in ran:
             input_model[inputs] = model
     return ModelRun(columns, model_force, wall_time, ran[0][1], input_model)
+
+
+def _run_order(experiment: Experiment) -> tuple[NDArray[np.int8], NDArray[np.int64], NDArray[np.int64]]:
+    """``(kind, index, stamp_ns)`` of every event in the order the model runs them: kind 0 an
+    input, 1 a measured sample, 2 a restart; index its position among those of its kind."""
+    n, m, r = experiment.input_ns.size, experiment.measured_ns.size, len(experiment.restarts)
+    restarts = experiment.restarts
+    kind = np.concatenate([np.zeros(n, np.int8), np.ones(m, np.int8), np.full(r, 2, np.int8)])
+    index = np.concatenate([np.arange(n), np.arange(m), np.arange(r)])
+    stamps = np.concatenate(
+        [experiment.input_ns, experiment.measured_ns, np.array([x.ns for x in restarts], dtype=np.int64)]
+    )
+    orders = np.concatenate(
+        [experiment.input_order, experiment.measured_order, np.array([x.order for x in restarts], np.int64)]
+    )
+    if experiment.by_arrival:
+        sequence = np.argsort(orders, kind="stable")
+    else:
+        # By stamp; at equal stamps in recording order (see the module docstring).
+        sequence = np.lexsort((orders, stamps))
+    return kind[sequence], index[sequence], stamps[sequence]
+
+
+def at_rest(experiment: Experiment) -> NDArray[np.bool_]:
+    """(m,) True for the measured samples the model takes from a contact at rest: after a
+    restart (RESET, PARAMETERS) and before the next input, the node's hold timer publishes the
+    fresh contact's output (:func:`_at_rest`), whatever its material."""
+    kind, index, _ = _run_order(experiment)
+    last_input, last_restart = _last_true(kind == 0), _last_true(kind == 2)
+    resting = np.zeros(experiment.measured_ns.size, dtype=np.bool_)
+    measured = kind == 1
+    resting[index[measured]] = last_restart[measured] > last_input[measured]
+    return resting
+
+
+def stretch(experiment: Experiment, after: int | None, before: int | None) -> Experiment:
+    """The part of a node log recorded after position ``after`` and before ``before`` (None:
+    from its start, to its end), cut at restarts so it runs as the whole record runs there:
+    the inputs between them, the measured samples from the first of those inputs on (those
+    before it are the contact at rest), the restarts between. ``t0_ns`` stays the record's, so
+    times still count from its first input; ``rejected_index`` and ``commands_before`` stay
+    too (they count the commands received, not the inputs run). InputError when no input is
+    left."""
+    low = -1 if after is None else after
+    high = np.iinfo(np.int64).max if before is None else before
+    inputs = (experiment.input_order > low) & (experiment.input_order < high)
+    if not inputs.any():
+        raise InputError(f"{experiment.input_topic}: no input between the record's restarts there")
+    measured = experiment.measured_order < high
+    if experiment.by_arrival:
+        measured &= experiment.measured_order > int(experiment.input_order[inputs].min())
+    else:
+        measured &= experiment.measured_ns >= int(experiment.input_ns[inputs].min())
+    return dataclasses.replace(
+        experiment,
+        input_ns=experiment.input_ns[inputs],
+        input_order=experiment.input_order[inputs],
+        input_mode=experiment.input_mode[inputs],
+        input_value=experiment.input_value[inputs],
+        input_index=None if experiment.input_index is None else experiment.input_index[inputs],
+        measured_ns=experiment.measured_ns[measured],
+        measured_force=experiment.measured_force[measured],
+        measured_order=experiment.measured_order[measured],
+        restarts=tuple(r for r in experiment.restarts if low < r.order < high),
+    )
 
 
 def _at_rest(contact: ContactConfig, index: NDArray[np.int64], model_force: NDArray[np.float64]) -> None:

@@ -56,7 +56,8 @@ def table(result: FitResult, title: str = "") -> str:
         f"- RMSE {result.rmse:.4g} N against the record's noise level {result.noise:.4g} N "
         f"(ratio {ratio:.3f}; about 1 when the model explains everything but the noise)",
         f"- r^2 {result.r2:.6f}, max error {result.max_error:.4g} N, {result.samples} samples fitted "
-        f"({int(result.used.size - np.count_nonzero(result.used))} left out: jumps, segment, time range)",
+        f"({int(result.used.size - np.count_nonzero(result.used))} left out: jumps, segment, time range, "
+        "at rest after a reset)",
         f"- stationarity: the last proposed step is {result.stationarity:.2g} standard deviations",
         f"- {result.model_runs} model runs in {result.wall_time:.3g} s; grid {grid.elements} elements "
         f"over {1e6 * grid.domain_radius:.4g} um",
@@ -87,7 +88,7 @@ def write_report(
 
     figure_path, table_path = report_paths(output)
     text = table(result, title)
-    run = run_model(result.model_contact, experiment)
+    run = run_model(result.model_contact, experiment, parameters=False)  # as the fit ran it
     t = experiment.time(experiment.measured_ns)
     measured, model, used = experiment.measured_force, run.model_force, result.used
     depth = _depth_at(experiment, experiment.measured_ns)

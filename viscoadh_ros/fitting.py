@@ -88,7 +88,16 @@ from scipy.optimize import least_squares
 from scipy.stats import qmc
 
 from viscoadh_ros.core.errors import InputError
-from viscoadh_ros.experiment import DEPTH, Experiment, run_model
+from viscoadh_ros.experiment import (
+    DEPTH,
+    PARAMETERS,
+    Experiment,
+    Restart,
+    at_rest,
+    changed_contact,
+    run_model,
+    stretch,
+)
 
 if TYPE_CHECKING:
     from viscoadh_ros.core.config import ContactConfig
@@ -519,7 +528,10 @@ class _Problem:
         base = self.contact if contact is None else contact
         started = wallclock.perf_counter()
         try:
-            run = run_model(with_parameters(base, self.values(u), self.kelvin), self.experiment)
+            # The trial throughout: a PARAMETERS event restarts the contact but keeps the trial
+            # (with the logged parameters the samples after it would not depend on the trial).
+            trial = with_parameters(base, self.values(u), self.kelvin)
+            run = run_model(trial, self.experiment, parameters=False)
         except ValueError:
             # Outside what the model accepts: a large residual steers the optimiser back.
             return self.measured + 1e3 * self.noise * math.sqrt(self.measured.size)
@@ -970,6 +982,68 @@ def _check_depths(contact: ContactConfig, experiment: Experiment) -> None:
         )
 
 
+def _parameter_side(experiment: Experiment, selected: NDArray[np.bool_], contact: ContactConfig) -> int:
+    """How many PARAMETERS events of ``experiment`` come before the ``selected`` samples (0 when
+    none is selected); FitError naming the change when the selection spans one: the node ran
+    one material before it and another after it, and a fit finds one (an outside tester's whole
+    record fitted 0.04998 J/m^2 to a contact that ran 0.05 and 0.08)."""
+    changes = [r for r in experiment.restarts if r.kind == PARAMETERS]
+    if not changes or not selected.any():
+        return 0
+    orders = np.array([r.order for r in changes], dtype=np.int64)
+    side = np.searchsorted(orders, experiment.measured_order)
+    sides = np.unique(side[selected]).tolist()
+    if len(sides) == 1:
+        return int(sides[0])
+    t = experiment.time(experiment.measured_ns)
+    spanned, ranges = [], []
+    before = contact
+    for k, change in enumerate(changes):
+        after = changed_contact(change, contact.id)
+        if sides[0] <= k < sides[-1]:
+            what = _changes(before, after) or "the contact's configuration"
+            spanned.append(f"t = {float(experiment.time(np.array([change.ns]))[0]):.6g} s ({what})")
+        before = after
+    for k in sides:
+        mine = t[selected & (side == k)]
+        low, high = math.floor(float(mine.min()) * 1e6) / 1e6, math.ceil(float(mine.max()) * 1e6) / 1e6
+        ranges.append(f"--time-range {low:.10g} {high:.10g}")
+    raise FitError(
+        f"the fitted samples span a parameter change of contact {contact.id!r} at "
+        + ", ".join(spanned)
+        + ": the node ran one material before it and another after it, and a fit finds one; fit one "
+        "side at a time, e.g. " + " or ".join(ranges)
+    )
+
+
+def _changes(before: ContactConfig, after: ContactConfig) -> str:
+    """``"work_of_adhesion 0.05 -> 0.08"``: the fit's parameters a change set, comma-separated."""
+    old, new = parameters_of(before), parameters_of(after)
+    changed = [name for name in new if old.get(name) != new[name]]
+    return ", ".join(f"{name} {old[name]:g} -> {new[name]:g}" if name in old else name for name in changed)
+
+
+def fitted_stretch(
+    experiment: Experiment, options: FitOptions, contact: ContactConfig
+) -> tuple[Experiment, Restart | None]:
+    """The stretch of ``experiment`` between PARAMETERS events that holds the samples
+    ``options`` select (`stretch`: what the fit needs to run; the model before the change it
+    starts at does not matter, a restart follows), and that change, None when the stretch
+    starts with the record. FitError when the selection spans a change. ``contact``: the one
+    the record starts with."""
+    changes = [r for r in experiment.restarts if r.kind == PARAMETERS]
+    if not changes:
+        return experiment, None
+    selected = segment_samples(experiment, options) & ~at_rest(experiment)
+    if not selected.any():
+        return experiment, None
+    side = _parameter_side(experiment, selected, contact)
+    start = changes[side - 1] if side > 0 else None
+    end = changes[side] if side < len(changes) else None
+    part = stretch(experiment, None if start is None else start.order, None if end is None else end.order)
+    return part, start
+
+
 def fit(
     contact: ContactConfig,
     experiment: Experiment,
@@ -982,7 +1056,10 @@ def fit(
 
     Raises FitError when the record cannot say anything about a free parameter or the fit
     does not reach a stationary point; a parameter it cannot pin down is reported as not
-    identified with its interval (`FitResult.identified`).
+    identified with its interval (`FitResult.identified`). The trial parameters run throughout
+    the record (a PARAMETERS event restarts the contact with them), so the samples fitted must
+    lie on one side of every parameter change (FitError otherwise; `fitted_stretch` cuts the
+    record to that side); samples of a contact at rest after a restart are not fitted.
     """
     started = wallclock.perf_counter()
     options = options or FitOptions()
@@ -1004,7 +1081,10 @@ def fit(
     depth = np.interp(
         experiment.time(experiment.measured_ns), experiment.time(experiment.input_ns), experiment.input_value
     )
-    selected = segment_samples(experiment, options)
+    # Samples of the contact at rest after a restart (before its next input) are the fresh
+    # contact's output whatever the material: nothing to fit.
+    selected = segment_samples(experiment, options) & ~at_rest(experiment)
+    _parameter_side(experiment, selected, contact)
     smooth = _widen(smooth_samples(experiment.measured_force, noise, depth), JUMP_WINDOW)
     used = smooth & selected
     _identify_checks(experiment, free, used, selected)
@@ -1210,13 +1290,17 @@ FILE_OPTIONS: dict[str, Any] = {
 
 @dataclass(frozen=True)
 class FileFit:
-    """What `fit_bag` fitted: the result, the record and the scene it came from."""
+    """What `fit_bag` fitted: the result, the record (the stretch fitted, `fitted_stretch`) and
+    the scene it came from."""
 
     result: FitResult
     experiment: Experiment
     scene: Any  # SceneConfig with the fitted contact
     contact_id: str
     written: tuple[str, ...]  # paths written (scene, figure, table)
+    #: The record's parameter change the fitted stretch starts at, s since its first input
+    #: (None: the stretch starts with the record).
+    changed_at: float | None = None
 
 
 def fit_bag(path: str, options: dict[str, Any]) -> FileFit:
@@ -1271,6 +1355,11 @@ def fit_bag(path: str, options: dict[str, Any]) -> FileFit:
             raise InputError(f"{str(path)!r} stores no scene (not a log of our node); pass --scene")
         scene = SceneConfig.from_dict(stored)
     contact = choose_contact(scene, opts["contact"], experiment.input_topic)
+    # A node log with a runtime parameter change: the side of it the samples are on, started
+    # from the contact the change set (unless a start scene is given).
+    experiment, change = fitted_stretch(experiment, fit_options, contact)
+    if change is not None and opts["scene"] is None:
+        contact = changed_contact(change, contact.id)
     result = fit(contact, experiment, free, kelvin=kelvin, options=fit_options)
     contacts = tuple(result.contact if c.id == contact.id else c for c in scene.contacts)
     fitted = dataclasses.replace(scene, contacts=contacts)
@@ -1285,7 +1374,8 @@ def fit_bag(path: str, options: dict[str, Any]) -> FileFit:
 
             title = f"{contact.id} from {Path(path).name} ({experiment.force_topic})"
             written.extend(str(p) for p in write_report(result, experiment, output, title=title))
-    return FileFit(result, experiment, fitted, contact.id, tuple(written))
+    since = None if change is None else float(experiment.time(np.array([change.ns]))[0])
+    return FileFit(result, experiment, fitted, contact.id, tuple(written), since)
 
 
 def fit_file(path: str, options: dict[str, Any]) -> dict[str, Any]:

@@ -102,6 +102,9 @@ def main(args: argparse.Namespace) -> int:
         f"fit of {done.contact_id} to {done.experiment.force_topic} ({result.samples} samples, "
         f"{result.model_runs} model runs, {result.wall_time:.3g} s):"
     )
+    if done.changed_at is not None:
+        start = "--scene" if args.scene is not None else "the contact it set"
+        print(f"  the record from the parameter change at t = {done.changed_at:.6g} s on; start: {start}")
     for name, value in result.values.items():
         unit = unit_of(name)
         if name not in result.uncertainty:
