@@ -372,7 +372,9 @@ def test_a_hold_that_fails_keeps_the_state_and_the_timer_and_the_next_command_is
 ) -> None:
     """Issue 11's untested path: the hold timer's step fails (a held force that creep makes
     unreachable; injected here, since no scene reaches it on cue). The contact keeps its state,
-    the timer keeps publishing it, and the next command is served from the kept state."""
+    the timer keeps trying and publishes nothing meanwhile (its last state stands: the kept
+    state stamped now would claim a time it does not describe; the first version of this test
+    wanted it republished), and the next command is served from the kept state."""
     node = _node(ros_context, ros_executor, {**FAULT_SCENE, "publish_rate": 100.0})
     client = EventClient(ros_context, ros_executor, spin_until, contact="visco", ahead_ns=0)
     now = client.node.get_clock().now().nanoseconds
@@ -399,17 +401,9 @@ def test_a_hold_that_fails_keeps_the_state_and_the_timer_and_the_next_command_is
 
     try:
         assert spin_until(client.executor, lambda: len(failed) >= 3, TIMEOUT), "the timer stopped"
-        assert spin_until(
-            client.executor,
-            lambda: sum(sim_time(s) >= failed[0] for s in client.states) >= 2,
-            TIMEOUT,
-        ), "no state published while the hold fails"
+        spin_until(client.executor, lambda: False, 0.1)  # anything published would arrive by now
         published = [s for s in client.states if sim_time(s) >= failed[0]]
-        assert all(
-            (s.depth, s.force, s.contact_radius)
-            == (kept.output.depth, kept.output.force, kept.output.contact_radius)
-            for s in published
-        ), "the state changed while the hold failed"
+        assert not published, "a state stamped after the contact's time while the hold fails"
         assert contact.simulator.snapshot().time == kept.time
         assert all(e.kind != 1 for e in client.events), "a failed hold is not a rejected command"
         # The next command is served from the kept state, exactly as a twin restored to it.

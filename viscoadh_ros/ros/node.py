@@ -391,9 +391,13 @@ class _Contact:
                 except ValueError as error:
                     # Holding an accepted control rarely fails (a held force that creep makes
                     # unreachable); the step changed nothing, the contact waits for a command.
+                    # Nothing is published: the contact is still at the time of its last state,
+                    # and that state stamped now would claim a time it does not describe.
                     self.node.get_logger().warning(
                         f"{self.id}: hold failed, state kept: {error}", throttle_duration_sec=WARN_THROTTLE_S
                     )
+                    self.counters.steps.add(time.perf_counter() - started)
+                    return
                 self.counters.steps.add(time.perf_counter() - started)
             self.last_publish_ns = now_ns
             state = self._state_locked(output, now_ns)
