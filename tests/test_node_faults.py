@@ -359,7 +359,11 @@ def test_diagnostics_warn_when_a_press_leaves_the_models_validity(
     assert spin_until(ros_executor, lambda: latest().get("in_contact") == "True", 4.0)
     ok = statuses[-1]
     assert latest()["small_slope_ok"] == "True" and ok.level == DiagnosticStatus.OK, ok.message
-    assert client.send(_command(client.t0 + 10_000_000, depth=5e-3)) is not None
+    # Stamped ahead of the clock again: waiting for /diagnostics can outlast the first stamp,
+    # and a command stamped before a hold tick is answered at the tick's time (send matches the
+    # answer by the command's stamp).
+    later = max(client.t0 + 10_000_000, client.node.get_clock().now().nanoseconds + 300_000_000)
+    assert client.send(_command(later, depth=5e-3)) is not None
     statuses.clear()
     assert spin_until(ros_executor, lambda: bool(statuses), 4.0)
     status = statuses[-1]
