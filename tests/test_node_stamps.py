@@ -182,3 +182,51 @@ def test_a_hand_command_stamped_before_a_hold_tick_is_answered_at_the_ticks_time
         stamps = _stamps(client.states[contact])
         assert np.all(np.diff(stamps) >= 0), (contact, np.diff(stamps))
         assert stamps[-1] > last_tick, f"{contact}: the timer holds after the hand command"
+
+
+@pytest.mark.parametrize("hand", [False, True], ids=["C/indentation", "hand/indentation"])
+@pytest.mark.parametrize(
+    "ahead_ns", [PERIOD_NS, 0, -5 * MS], ids=["a period ahead", "at the clock", "5 ms behind"]
+)
+def test_commands_at_the_timers_rate_get_no_hold_states_between_them_whatever_their_stamps(
+    client: _SimClockClient, hand: bool, ahead_ns: int
+) -> None:
+    """Commands every timer period (20 ms of /clock), each sent once the clock reached the
+    previous sample's time and stamped ``ahead_ns`` from the clock: every C/state is a command's
+    answer (0.8.0 republished a period-ahead stream's states at the same stamps; at or behind
+    the clock its timer put a hold state between two commands and applied the next one late, a
+    hold then a jump instead of the ramp), the answers are those of the core stepped on the
+    samples, and once the commands stop the timer holds."""
+    depths = np.interp(np.arange(30), [0, 15, 29], [-1e-6, 8e-6, 2e-6])
+    start = T0_NS + 10 * PERIOD_NS
+    client.tick(start - PERIOD_NS)
+    references = {i: _reference(i) for i in IDS}
+    for k, depth in enumerate(depths.tolist()):
+        clock = start + k * PERIOD_NS
+        client.tick(clock)
+        stamp = clock + ahead_ns
+        expected = {i: references[i].step(k * PERIOD_NS * 1e-9, depth=depth) for i in IDS}
+        if hand:
+            state = client.send_hand(stamp, [depth, depth], IDS)
+            assert stamp_to_ns(state.header.stamp) == stamp, k
+            for j, i in enumerate(IDS):
+                assert _outputs(state, j) == _outputs(expected[i], None), (k, i)
+        else:
+            state = client.send("visco", stamp, depth)
+            assert stamp_to_ns(state.header.stamp) == stamp, k
+            assert _outputs(state) == _outputs(expected["visco"], None), k
+    client.settle()
+    # Every C/state from the first command on is a command's answer, one per command (hand
+    # commands are answered on hand/state only).
+    first = start + ahead_ns
+    for i in IDS if hand else ["visco"]:
+        during = [s.commands_received for s in client.states[i] if stamp_to_ns(s.header.stamp) >= first]
+        assert during == ([] if hand else list(range(1, depths.size + 1))), f"{i}: hold states {during}"
+    # The commands stopped: the timer takes over.
+    last = start + (depths.size - 1) * PERIOD_NS
+    client.tick(last + 4 * PERIOD_NS)
+    client.settle()
+    for i in IDS if hand else ["visco"]:
+        stamps = _stamps(client.states[i])
+        assert stamps[-1] == last + 4 * PERIOD_NS, f"{i}: no hold state after the commands"
+        assert np.all(np.diff(stamps) >= 0), (i, np.diff(stamps))

@@ -151,6 +151,9 @@ class _Contact:
         self.last_command_ns: int | None = None
         self.last_clock_ns: int | None = None
         self.last_publish_ns: int | None = None
+        # Node clock when the last accepted command (C/indentation or hand) was received: the
+        # hold timer stays out of the way while commands keep coming (see :meth:`on_timer`).
+        self.last_received_ns: int | None = None
         # The contact's time, node-clock ns: the time the last state it published (C/state, or
         # its row of a hand/state) describes and is stamped with, since start or the last
         # restart (reset, parameter change, clock jump back). It never goes back: a command
@@ -217,6 +220,7 @@ class _Contact:
         self.epoch_ns = None
         self.last_command_ns = None
         self.last_publish_ns = None
+        self.last_received_ns = None
         self.time_ns = None
         self.hold = {}
 
@@ -361,6 +365,7 @@ class _Contact:
         self.last_command_ns = stamp_ns
         self.time_ns = at_ns
         self.last_publish_ns = now_ns
+        self.last_received_ns = now_ns
 
     def _command_stamp_locked(self, sec: int, nanosec: int, now_ns: int) -> int:
         """The command's stamp, ns on the node clock (zero: ``now_ns``); InputError for a stamp
@@ -390,10 +395,19 @@ class _Contact:
             # between the read and the lock would look like the clock going back.
             now_ns = self.node.now_ns()
             self._check_clock_locked(now_ns)
+            period = self.timer.timer_period_ns
+            if self.last_received_ns is not None and now_ns - self.last_received_ns < period * 3 // 2:
+                # Commands keep coming at the timer's rate (one came within the last period and
+                # a half: half a period for jitter), whatever their stamps: each publishes its own
+                # state. A hold state between two would be extra, and would take the contact's
+                # time past the next command's stamp (applied late: a hold, then a jump). 0.8.0
+                # let the timer in half a period after a command, so at the timer's rate it put
+                # a hold state between two commands at every tick of the wrong phase.
+                return
             if self.last_publish_ns is not None:
                 since = now_ns - self.last_publish_ns
-                # Commands arriving at least as fast as the timer already publish every state.
-                if since < self.timer.timer_period_ns // 2:
+                # A tick that catches up on a late one publishes nothing new.
+                if since < period // 2:
                     return
                 if self.simulator.is_idle and since < IDLE_PUBLISH_PERIOD_NS:
                     return
