@@ -381,7 +381,9 @@ def test_a_hold_that_fails_keeps_the_state_and_the_timer_and_the_next_command_is
     wanted it republished), and the next command is served from the kept state."""
     node = _node(ros_context, ros_executor, {**FAULT_SCENE, "publish_rate": 100.0})
     client = EventClient(ros_context, ros_executor, spin_until, contact="visco", ahead_ns=0)
-    now = client.node.get_clock().now().nanoseconds
+    # 50 ms ahead of the clock: a rest heartbeat or a hold tick published between reading the
+    # clock and the node receiving the command would have it answered at that state's time.
+    now = client.node.get_clock().now().nanoseconds + 50_000_000
     pressed = client.send(_command(now, depth=5e-6))
     assert pressed is not None
     held = client.send(_command(now + 1_000_000, mode=IndentationCommand.FORCE, force=pressed.force))
