@@ -2,6 +2,7 @@
 
 import array
 import copy
+import re
 from pathlib import Path
 
 import numpy as np
@@ -13,8 +14,10 @@ from viscoadh_ros.core.config import (
     NODE_KEYS,
     PHYSICAL_RANGES,
     SceneConfig,
+    _check_range,
     default_scene_path,
     load_default_scene,
+    range_text,
 )
 from viscoadh_ros.core.errors import ConfigError
 from viscoadh_ros.core.rheology import prony_to_creep
@@ -182,7 +185,7 @@ def test_keys_of_other_shapes_are_ignored_and_dropped():
         ({"finger__indenter__radius": None}, r"^finger\.indenter\.radius is required for shape 'sphere'"),
         (
             {"finger__indenter": {"shape": "cone", "half_angle": 2.0}},
-            r"^finger\.indenter\.half_angle must be in \[0\.001, 1\.5698\] rad \(got 2\)",
+            r"^finger\.indenter\.half_angle must be in \[0\.001, 1\.569796\] rad \(got 2\)",
         ),
         ({"finger__indenter": {"shape": "cube"}}, r"^finger\.indenter\.shape must be one of"),
         (
@@ -290,11 +293,36 @@ def test_numbers_outside_the_physical_range_are_refused_with_the_range(changes, 
 
 def test_every_physical_range_is_documented():
     text = (Path(__file__).resolve().parents[1] / "docs" / "configuration.md").read_text()
-    for key, (low, high, _) in PHYSICAL_RANGES.items():
+    for key in PHYSICAL_RANGES:
         row = next((line for line in text.splitlines() if line.startswith(f"| `{key.split('.')[1]}` |")), "")
-        assert f"{low:.6g}" in row and f"{high:.6g}" in row, (
-            f"{key}: range [{low:.6g}, {high:.6g}] not in {row!r}"
-        )
+        assert range_text(key) in row, f"{key}: range {range_text(key)} not in {row!r}"
+
+
+@pytest.mark.parametrize("key", sorted(PHYSICAL_RANGES))
+def test_the_printed_bounds_of_every_range_are_accepted(key):
+    """Outside tester: half_angle was refused at the upper bound its own error printed ('must
+    be in [0.001, 1.5698] rad (got 1.5698)'; the bound is pi/2 - 0.001 = 1.5697963). Both
+    bounds an error prints, and docs/configuration.md with it, pass the range check."""
+    low, high, _ = PHYSICAL_RANGES[key]
+    name = f"finger.{key}"
+    for outside in (high * 2.0 + 1.0, low - abs(low) - 1.0):
+        with pytest.raises(ConfigError, match=r"must be in \[") as refused:
+            _check_range(name, outside)
+        printed = re.search(r"must be in \[([^,]+), ([^\]]+)\]", str(refused.value))
+        assert printed is not None and printed.group(0) == f"must be in {range_text(key)}"
+        for bound in printed.groups():
+            _check_range(name, float(bound))  # accepted: no ConfigError
+            _check_range(name, (float(bound),))
+
+
+def test_a_cone_at_the_printed_upper_half_angle_loads():
+    """The tester's case end to end: the half-angle the refusal names as the upper bound loads,
+    and a value just above the bound is refused with a number that is not the printed bound."""
+    refusal = r"half_angle must be in \[0\.001, 1\.569796\] rad \(got 1\.5698\)"
+    with pytest.raises(ConfigError, match=refusal):
+        SceneConfig.from_dict(scene_with(finger__indenter={"shape": "cone", "half_angle": 1.5698}))
+    scene = SceneConfig.from_dict(scene_with(finger__indenter={"shape": "cone", "half_angle": 1.569796}))
+    assert scene.contact("finger").indenter.half_angle == 1.569796
 
 
 def test_file_errors_are_config_errors(tmp_path):

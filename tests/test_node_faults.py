@@ -359,7 +359,11 @@ def test_diagnostics_warn_when_a_press_leaves_the_models_validity(
     assert spin_until(ros_executor, lambda: latest().get("in_contact") == "True", 4.0)
     ok = statuses[-1]
     assert latest()["small_slope_ok"] == "True" and ok.level == DiagnosticStatus.OK, ok.message
-    assert client.send(_command(client.t0 + 10_000_000, depth=5e-3)) is not None
+    # Stamped ahead of the clock again: waiting for /diagnostics can outlast the first stamp,
+    # and a command stamped before a hold tick is answered at the tick's time (send matches the
+    # answer by the command's stamp).
+    later = max(client.t0 + 10_000_000, client.node.get_clock().now().nanoseconds + 300_000_000)
+    assert client.send(_command(later, depth=5e-3)) is not None
     statuses.clear()
     assert spin_until(ros_executor, lambda: bool(statuses), 4.0)
     status = statuses[-1]
@@ -372,10 +376,14 @@ def test_a_hold_that_fails_keeps_the_state_and_the_timer_and_the_next_command_is
 ) -> None:
     """Issue 11's untested path: the hold timer's step fails (a held force that creep makes
     unreachable; injected here, since no scene reaches it on cue). The contact keeps its state,
-    the timer keeps publishing it, and the next command is served from the kept state."""
+    the timer keeps trying and publishes nothing meanwhile (its last state stands: the kept
+    state stamped now would claim a time it does not describe; the first version of this test
+    wanted it republished), and the next command is served from the kept state."""
     node = _node(ros_context, ros_executor, {**FAULT_SCENE, "publish_rate": 100.0})
     client = EventClient(ros_context, ros_executor, spin_until, contact="visco", ahead_ns=0)
-    now = client.node.get_clock().now().nanoseconds
+    # 50 ms ahead of the clock: a rest heartbeat or a hold tick published between reading the
+    # clock and the node receiving the command would have it answered at that state's time.
+    now = client.node.get_clock().now().nanoseconds + 50_000_000
     pressed = client.send(_command(now, depth=5e-6))
     assert pressed is not None
     held = client.send(_command(now + 1_000_000, mode=IndentationCommand.FORCE, force=pressed.force))
@@ -399,17 +407,9 @@ def test_a_hold_that_fails_keeps_the_state_and_the_timer_and_the_next_command_is
 
     try:
         assert spin_until(client.executor, lambda: len(failed) >= 3, TIMEOUT), "the timer stopped"
-        assert spin_until(
-            client.executor,
-            lambda: sum(sim_time(s) >= failed[0] for s in client.states) >= 2,
-            TIMEOUT,
-        ), "no state published while the hold fails"
+        spin_until(client.executor, lambda: False, 0.1)  # anything published would arrive by now
         published = [s for s in client.states if sim_time(s) >= failed[0]]
-        assert all(
-            (s.depth, s.force, s.contact_radius)
-            == (kept.output.depth, kept.output.force, kept.output.contact_radius)
-            for s in published
-        ), "the state changed while the hold failed"
+        assert not published, "a state stamped after the contact's time while the hold fails"
         assert contact.simulator.snapshot().time == kept.time
         assert all(e.kind != 1 for e in client.events), "a failed hold is not a rejected command"
         # The next command is served from the kept state, exactly as a twin restored to it.

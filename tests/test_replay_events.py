@@ -37,7 +37,9 @@ class NodeRules:
     """One contact handled by the node's rules (ros/node.py ``_Contact.on_command``,
     ``on_timer``, ``_reset_locked``, ``replace_config_locked`` of the node that logs events:
     a contact with no command since start, reset or a parameter change is left at rest by the
-    hold timer), logging what the node logs."""
+    hold timer; a command stamped before the contact's last published state is applied, and
+    answered, at that state's time; the timer publishes only past it), logging what the node
+    logs."""
 
     def __init__(self, contact: ContactConfig, recorder: McapRecorder, *, events: bool = True) -> None:
         self.events = events  # False: a 0.1.0 node, which logged no events
@@ -46,10 +48,12 @@ class NodeRules:
         self.rec = recorder
         self.epoch: int | None = None
         self.last_command: int | None = None
+        self.time: int | None = None  # the stamp of the last published state since a restart
         self.hold: dict[str, float] = {}
         self.count = 0  # commands received since start
         self.rejected = 0
         self.forces: list[float] = []  # every published (logged) force, in order
+        self.answers: list[int] = []  # the stamps of the accepted commands' states
 
     def _sim_time(self, ns: int) -> float:
         if self.epoch is None:
@@ -60,6 +64,7 @@ class NodeRules:
         wrench = conversions.wrench(output, stamp_ns=stamp_ns, frame_id="contact")
         self.rec.record("/finger/wrench", wrench, now_ns)
         self.forces.append(output.force)
+        self.time = stamp_ns
 
     def _event(self, kind: int, now_ns: int, **fields: Any) -> None:
         if not self.events:
@@ -80,10 +85,11 @@ class NodeRules:
             control = conversions.command_control(msg)
             if self.last_command is not None and stamp < self.last_command:
                 raise ValueError("header.stamp is older than the last command's")
+            at = stamp if self.time is None else max(stamp, self.time)
             if self.last_command is None:
                 self.sim.reset(time=0.0)
-                self.epoch = stamp
-            output = self.sim.step(max(self._sim_time(stamp), self.sim.time), **control)
+                self.epoch = at
+            output = self.sim.step(self._sim_time(at), **control)
         except ValueError as error:
             self.rejected += 1
             self._event(
@@ -95,10 +101,13 @@ class NodeRules:
             )
             return False
         self.hold, self.last_command = control, stamp
-        self._publish(output, stamp, now_ns)
+        self._publish(output, at, now_ns)
+        self.answers.append(at)
         return True
 
     def tick(self, now_ns: int) -> None:
+        if self.time is not None and now_ns <= self.time:
+            return  # the last state already describes now or later
         # No command since start or reset: nothing to hold, the contact stays at rest.
         output = self.sim.output
         if self.last_command is not None:
@@ -109,14 +118,14 @@ class NodeRules:
 
     def reset(self, now_ns: int) -> None:
         self.sim.reset(time=0.0)
-        self.epoch = self.last_command = None
+        self.epoch = self.last_command = self.time = None
         self.hold = {}
         self._event(ContactEvent.RESET, now_ns, reason="reset")
 
     def parameters(self, now_ns: int, contact: ContactConfig) -> None:
         assert self.sim.is_idle, "the node changes a contact's parameters only when idle"
         self.sim, self.contact = ContactSimulator(contact), contact
-        self.epoch = self.last_command = None
+        self.epoch = self.last_command = self.time = None
         self.hold = {}
         scene = dataclasses.replace(SCENE, contacts=(contact,))
         self._event(
@@ -141,8 +150,9 @@ def _cycle(node: NodeRules, start_ns: int, *, pull_to: float = -30e-6) -> int:
     return start_ns + 900 * MS
 
 
-def _session(path: Path, *, events: bool = True) -> tuple[list[float], dict[str, int]]:
-    """The log of a session; returns the logged forces and the node's counts."""
+def _session(path: Path, *, events: bool = True) -> tuple[list[float], dict[str, int], list[int]]:
+    """The log of a session; returns the logged forces, the node's counts and the stamps of the
+    accepted commands' states."""
     counts = {"rejected": 0, "accepted": 0}
     with McapRecorder(path, scene=SCENE.to_dict(), queue_size=100_000) as rec:
         node = NodeRules(SCENE.contact("finger"), rec, events=events)
@@ -169,6 +179,9 @@ def _session(path: Path, *, events: bool = True) -> tuple[list[float], dict[str,
             node.reset(t)
             node.tick(t + 20 * MS)
             node.tick(t + 40 * MS)
+            # The first command after the reset, stamped before the rest heartbeat it arrives
+            # after: its history starts at the heartbeat's time.
+            node.command(t + 41 * MS, t + 30 * MS, depth=-2e-6)
             # The same cycle again, then a parameter change once idle, ticks, a third cycle.
             end = _cycle(node, t + 100 * MS)
             t = end + 500 * MS
@@ -181,20 +194,19 @@ def _session(path: Path, *, events: bool = True) -> tuple[list[float], dict[str,
             node.tick(t + 40 * MS)
             _cycle(node, t + 100 * MS, pull_to=-60e-6)
         counts = {"rejected": node.rejected, "accepted": node.count - node.rejected}
-    return node.forces, counts
+    return node.forces, counts, node.answers
 
 
 @pytest.fixture(scope="module")
-def session(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, list[float], dict[str, int]]:
+def session(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, list[float], dict[str, int], list[int]]:
     path = tmp_path_factory.mktemp("events") / "session.mcap"
-    forces, counts = _session(path)
-    return path, forces, counts
+    return path, *_session(path)
 
 
 def test_replay_reproduces_rejections_reset_and_parameter_change(
-    session: tuple[Path, list[float], dict[str, int]], tmp_path: Path
+    session: tuple[Path, list[float], dict[str, int], list[int]], tmp_path: Path
 ) -> None:
-    path, forces, counts = session
+    path, forces, counts, answers = session
     summary_path, out = tmp_path / "summary.json", tmp_path / "out.mcap"
     assert main(["replay", str(path), "-o", str(out), "--json", str(summary_path)]) == 0
     summary = json.loads(summary_path.read_text())
@@ -225,13 +237,17 @@ def test_replay_reproduces_rejections_reset_and_parameter_change(
     assert [s.commands_received for s in states] == list(range(1, counts["accepted"] + 1))
     assert states[0].commands_rejected == 0 and states[-1].commands_rejected == counts["rejected"]
     assert states[3].commands_rejected == 3, "NaN, unknown mode and older stamp before the 4th"
+    # ... stamped as the node stamped its answers: a command stamped before a hold tick (or a
+    # rest heartbeat) it arrived after, at the tick's time (the 0.8.0 replay used its stamp).
+    stamps = [conversions.stamp_to_ns(s.header.stamp) for s in states]
+    assert stamps == answers
 
 
 def test_log_without_events_still_replays(tmp_path: Path) -> None:
     """A 0.1.0 log has no events: what the node always refuses (NaN, unknown mode, an older
     stamp) is recognised without them."""
     path = tmp_path / "old.mcap"
-    forces, _ = _session(path, events=False)
+    forces, _, _ = _session(path, events=False)
     summary_path = tmp_path / "summary.json"
     assert main(["replay", str(path), "-o", str(tmp_path / "o.mcap"), "--json", str(summary_path)]) == 0
     summary = json.loads(summary_path.read_text())
@@ -253,7 +269,7 @@ def test_event_naming_a_command_the_log_lacks_is_an_error(tmp_path: Path, capsys
 
 
 def test_recording_by_another_recorder_with_events_replays_by_the_node_rules(
-    session: tuple[Path, list[float], dict[str, int]], tmp_path: Path
+    session: tuple[Path, list[float], dict[str, int], list[int]], tmp_path: Path
 ) -> None:
     """The same session copied by a plain MCAP writer (what `ros2 bag record` makes: no
     viscoadh metadata, so the scene comes from --scene): its `finger/events` make it a node
@@ -261,7 +277,7 @@ def test_recording_by_another_recorder_with_events_replays_by_the_node_rules(
     from mcap.reader import make_reader
     from mcap.writer import Writer
 
-    path, forces, _ = session
+    path, forces, _, _ = session
     copy, scene_file = tmp_path / "rosbag.mcap", tmp_path / "scene.yaml"
     with open(path, "rb") as source, open(copy, "wb") as target:
         reader, writer = make_reader(source), Writer(target)

@@ -19,7 +19,9 @@ Two orders of events:
   stores the software version, or in any recording that holds the contact's ``C/events``)
   runs in recording order, which is the order the node
   handled things in: it logs each command on receipt, before its answer, and its hold-timer
-  states as it publishes them. The node's verdicts are applied as the node made them: a
+  states as it publishes them. A command stamped before a state the node already published
+  for the contact (a hold tick's, a rest heartbeat's) runs at that state's time, as the node
+  applied (and stamped) it. The node's verdicts are applied as the node made them: a
   command refused by the node (a ``COMMAND_REJECTED`` ``ContactEvent`` on ``C/events`` naming
   its index among the commands received; or, in logs without events, what the node always
   refuses: an unknown mode, a non-finite value, a stamp older than the last accepted command's)
@@ -93,7 +95,9 @@ class Experiment:
     """
 
     t0_ns: int
-    input_ns: NDArray[np.int64]  # (n,) stamps of the accepted inputs, in run order
+    #: (n,) stamps of the accepted inputs, in run order; in a node log the time the node applied
+    #: each at (its stamp, or the contact's time when later: see ``_applied_ns``).
+    input_ns: NDArray[np.int64]
     input_order: NDArray[np.int64]  # (n,) positions of the inputs in the recording
     input_mode: NDArray[np.uint8]  # (n,) DEPTH or FORCE
     input_value: NDArray[np.float64]  # (n,) depth, m, or force, N
@@ -300,6 +304,10 @@ def load_experiment(
         run = np.argsort(order, kind="stable")
         run = run[keep[run]]
         index = index[run]
+        # The node applies a command stamped before the contact's last published state at that
+        # state's time (and stamps its answer so): run each input at the time the node did.
+        stamps = stamps.copy()
+        stamps[run] = _applied_ns(bag, inputs, stamps[run], order[run], restarts)
     else:
         _refuse_mid_history(bag, inputs, order, earlier, ())
         bad = np.flatnonzero((mode != DEPTH) & (mode != FORCE))
@@ -534,6 +542,52 @@ def _refused_commands(
             )
         refused[k] = rejection.reason
     return refused
+
+
+def _applied_ns(
+    bag: Bag,
+    inputs: str,
+    stamps: NDArray[np.int64],
+    order: NDArray[np.int64],
+    restarts: tuple[Restart, ...],
+) -> NDArray[np.int64]:
+    """The time the node applied each accepted command at (``stamps``, ``order``: the accepted
+    commands in recording order): its stamp, or the contact's time when that is later, the
+    stamp of the last state it published (``C/state``, else ``C/wrench``, beside ``inputs``)
+    or of a command it applied, since the last restart before it (ros/node.py
+    ``_Contact._applied_ns``). The stamps as they are when the log holds neither topic."""
+    base = inputs.rsplit("/", 1)[0]
+    published = next((t for t in (base + "/state", base + "/wrench") if t in bag.topics), None)
+    if published is None:
+        return stamps
+    state_ns, state_order = _stamps_of(bag, published)
+    values = np.concatenate([stamps, state_ns])
+    orders = np.concatenate([order, state_order])
+    by_order = np.argsort(orders, kind="stable")
+    values, orders = values[by_order], orders[by_order]
+    # A restart (reset, parameter change, clock jump back) forgets the contact's time.
+    segment = np.searchsorted(np.array([r.order for r in restarts], dtype=np.int64), orders)
+    running = np.empty_like(values)
+    for seg in np.unique(segment).tolist():
+        mine = np.flatnonzero(segment == seg)  # contiguous: sorted by order
+        running[mine] = np.maximum.accumulate(values[mine])
+    applied = np.empty_like(running)
+    applied[by_order] = running
+    return applied[: stamps.size]
+
+
+def _stamps_of(bag: Bag, topic: str) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """``(header stamp ns, order)`` of every message of the stamped ``topic``."""
+    log_ns, order, rows = bag.rows(topic)
+    columns = None if rows is None else cdr.decode(bag.topics[topic], rows, ())
+    if columns is not None and "stamp_ns" in columns:
+        return columns["stamp_ns"], order
+    messages = list(bag.messages([topic]))
+    stamp_ns = np.array(
+        [m.msg.header.stamp.sec * 1_000_000_000 + m.msg.header.stamp.nanosec for m in messages],
+        dtype=np.int64,
+    )
+    return stamp_ns, np.array([m.order for m in messages], dtype=np.int64)
 
 
 def _node_verdicts(

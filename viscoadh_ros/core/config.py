@@ -365,16 +365,48 @@ def _unknown_key(key: str, valid: list[str]) -> ConfigError:
     return ConfigError(f"unknown parameter {key!r}{hint}")
 
 
+def _bound_text(bound: float, *, upper: bool) -> str:
+    """``bound`` with the fewest significant digits, at least 6, that do not print it outside
+    the range it closes (an upper bound never above itself, a lower one never below), so the
+    printed bound is itself accepted: at 6 digits pi/2 - 0.001 printed as 1.5698, which is
+    above it and was refused at its own printed value."""
+    for digits in range(6, 17):
+        text = f"{bound:.{digits}g}"
+        if (float(text) <= bound) if upper else (float(text) >= bound):
+            return text
+    return f"{bound:.17g}"  # 17 significant digits give every float back exactly
+
+
+def _number_text(number: float) -> str:
+    """``number`` with the fewest significant digits, at least 6, that give it back exactly,
+    so a refused value just beyond a bound never prints as a number inside the range."""
+    for digits in range(6, 17):
+        text = f"{number:.{digits}g}"
+        if float(text) == number:
+            return text
+    return f"{number:.17g}"
+
+
+def range_text(key: str) -> str:
+    """``[low, high]`` of the :data:`PHYSICAL_RANGES` entry ``key`` (relative, e.g.
+    ``"indenter.half_angle"``) as the errors and docs/configuration.md print it: both printed
+    bounds are inside the range (see :func:`_bound_text`)."""
+    low, high, _ = PHYSICAL_RANGES[key]
+    return f"[{_bound_text(low, upper=False)}, {_bound_text(high, upper=True)}]"
+
+
 def _check_range(key: str, value: Any) -> None:
     """ConfigError naming ``key`` and its :data:`PHYSICAL_RANGES` entry if ``value`` (or an
     element of it) lies outside."""
-    low, high, unit = PHYSICAL_RANGES[key.split(".", 1)[1]]
+    relative = key.split(".", 1)[1]
+    low, high, unit = PHYSICAL_RANGES[relative]
     values = value if isinstance(value, tuple) else (value,)
     for index, number in enumerate(values):
         if not low <= number <= high:
             name = f"{key}[{index}]" if isinstance(value, tuple) else key
             raise ConfigError(
-                f"{name} must be in [{low:.6g}, {high:.6g}]{' ' + unit if unit else ''} (got {number:.6g})"
+                f"{name} must be in {range_text(relative)}{' ' + unit if unit else ''} "
+                f"(got {_number_text(number)})"
             )
 
 

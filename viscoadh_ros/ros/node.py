@@ -151,6 +151,14 @@ class _Contact:
         self.last_command_ns: int | None = None
         self.last_clock_ns: int | None = None
         self.last_publish_ns: int | None = None
+        # Node clock when the last accepted command (C/indentation or hand) was received: the
+        # hold timer stays out of the way while commands keep coming (see :meth:`on_timer`).
+        self.last_received_ns: int | None = None
+        # The contact's time, node-clock ns: the time the last state it published (C/state, or
+        # its row of a hand/state) describes and is stamped with, since start or the last
+        # restart (reset, parameter change, clock jump back). It never goes back: a command
+        # stamped before it is applied at it (see :meth:`_applied_ns`).
+        self.time_ns: int | None = None
         # Commands received on C/indentation since start (accepted or not): the next one's index.
         self.commands_seen = 0
         # The last accepted control ({"depth": d} or {"force": f}); the hold timer keeps it, so
@@ -212,6 +220,8 @@ class _Contact:
         self.epoch_ns = None
         self.last_command_ns = None
         self.last_publish_ns = None
+        self.last_received_ns = None
+        self.time_ns = None
         self.hold = {}
 
     def _check_clock_locked(self, now_ns: int) -> None:
@@ -287,7 +297,8 @@ class _Contact:
     def handle_command(
         self, sec: int, nanosec: int, mode: int, depth: float, force: float, received: Any
     ) -> None:
-        """Step to the command's stamp and publish the state at that stamp, or reject it
+        """Step to the command's stamp (or the contact's time when later, see
+        :meth:`_applied_ns`) and publish the state stamped with that time, or reject it
         (the contact unchanged, a COMMAND_REJECTED event with the reason). ``received``: the
         command as it came, a message object or its CDR payload, for the log."""
         with self.lock:
@@ -302,14 +313,13 @@ class _Contact:
             try:
                 stamp_ns = self._command_stamp_locked(sec, nanosec, now_ns)
                 control = conversions.control_of(mode, depth, force)
+                at_ns = self._applied_ns(stamp_ns)
                 # The first command since start or reset: nothing says where the indenter was
-                # before, so the contact's history starts at rest at this stamp (the way
+                # before, so the contact's history starts at rest at this time (the way
                 # simulate_history starts at its first sample). Nothing changes until the step
                 # succeeded (the simulator's step is a transaction).
-                epoch_ns = stamp_ns if self.last_command_ns is None else self.epoch_ns
-                # A hold tick may have advanced the contact past a command that was stamped
-                # (just) before it: apply it now rather than go back in time.
-                target = max((stamp_ns - epoch_ns) * 1e-9, self.simulator.time)
+                epoch_ns = at_ns if self.last_command_ns is None else self.epoch_ns
+                target = (at_ns - epoch_ns) * 1e-9
                 started = time.perf_counter()
                 output = self.simulator.step(target, **control)
                 self.counters.steps.add(time.perf_counter() - started)
@@ -324,21 +334,38 @@ class _Contact:
                     stamp=Time(sec=sec, nanosec=nanosec),
                 )
                 return
-            self.accepted_locked(epoch_ns, stamp_ns, now_ns, control)
-            state = self._state_locked(output, stamp_ns)
-        self._publish(state, output, stamp_ns, now_ns)
+            self.accepted_locked(epoch_ns, stamp_ns, at_ns, now_ns, control)
+            state = self._state_locked(output, at_ns)
+        self._publish(state, output, at_ns, now_ns)
+
+    def _applied_ns(self, stamp_ns: int) -> int:
+        """When a command stamped ``stamp_ns`` applies: at its stamp, or at the contact's time
+        when that is later (a hold tick, or before the first command a rest heartbeat, already
+        published a state stamped after it), so the contact's time and the stamps of its states
+        never go back. Its state is stamped with this time, the time it describes."""
+        return stamp_ns if self.time_ns is None else max(stamp_ns, self.time_ns)
 
     def accepted_locked(
-        self, epoch_ns: int, stamp_ns: int, now_ns: int, control: dict[str, float], *, count: bool = True
+        self,
+        epoch_ns: int,
+        stamp_ns: int,
+        at_ns: int,
+        now_ns: int,
+        control: dict[str, float],
+        *,
+        count: bool = True,
     ) -> None:
-        """Book an accepted command stamped ``stamp_ns``; ``count``: it came on
-        ``C/indentation`` (a hand command counts on the hand's counters instead)."""
+        """Book an accepted command stamped ``stamp_ns``, applied at ``at_ns`` (see
+        :meth:`_applied_ns`); ``count``: it came on ``C/indentation`` (a hand command counts on
+        the hand's counters instead)."""
         if count:
             self.counters.commands_received += 1
         self.epoch_ns = epoch_ns
         self.hold = control
         self.last_command_ns = stamp_ns
+        self.time_ns = at_ns
         self.last_publish_ns = now_ns
+        self.last_received_ns = now_ns
 
     def _command_stamp_locked(self, sec: int, nanosec: int, now_ns: int) -> int:
         """The command's stamp, ns on the node clock (zero: ``now_ns``); InputError for a stamp
@@ -368,21 +395,30 @@ class _Contact:
             # between the read and the lock would look like the clock going back.
             now_ns = self.node.now_ns()
             self._check_clock_locked(now_ns)
+            period = self.timer.timer_period_ns
+            if self.last_received_ns is not None and now_ns - self.last_received_ns < period * 3 // 2:
+                # Commands keep coming at the timer's rate (one came within the last period and
+                # a half: half a period for jitter), whatever their stamps: each publishes its own
+                # state. A hold state between two would be extra, and would take the contact's
+                # time past the next command's stamp (applied late: a hold, then a jump). 0.8.0
+                # let the timer in half a period after a command, so at the timer's rate it put
+                # a hold state between two commands at every tick of the wrong phase.
+                return
             if self.last_publish_ns is not None:
                 since = now_ns - self.last_publish_ns
-                # Commands arriving at least as fast as the timer already publish every state.
-                if since < self.timer.timer_period_ns // 2:
+                # A tick that catches up on a late one publishes nothing new.
+                if since < period // 2:
                     return
                 if self.simulator.is_idle and since < IDLE_PUBLISH_PERIOD_NS:
                     return
+            if self.time_ns is not None and now_ns <= self.time_ns:
+                # The contact's last state already describes now, or a later time (a command
+                # stamped ahead of the clock, within command.max_future_s): a state stamped now
+                # would repeat it or make the state stamps go back.
+                return
             # No command since start or reset: the contact is out of touch and there is nothing
             # to hold (holding depth 0 would touch the surface, and an adhesive contact snaps in).
             target = self._sim_time(now_ns)
-            if self.last_command_ns is not None and target < self.simulator.time:
-                # A command stamped ahead of the clock (within command.max_future_s) put the
-                # contact ahead of now, and its state went out with that stamp: a state stamped
-                # now would describe a later time and make the state stamps go backwards.
-                return
             output = self.simulator.output
             if target > self.simulator.time:
                 started = time.perf_counter()
@@ -391,11 +427,16 @@ class _Contact:
                 except ValueError as error:
                     # Holding an accepted control rarely fails (a held force that creep makes
                     # unreachable); the step changed nothing, the contact waits for a command.
+                    # Nothing is published: the contact is still at the time of its last state,
+                    # and that state stamped now would claim a time it does not describe.
                     self.node.get_logger().warning(
                         f"{self.id}: hold failed, state kept: {error}", throttle_duration_sec=WARN_THROTTLE_S
                     )
+                    self.counters.steps.add(time.perf_counter() - started)
+                    return
                 self.counters.steps.add(time.perf_counter() - started)
             self.last_publish_ns = now_ns
+            self.time_ns = now_ns
             state = self._state_locked(output, now_ns)
         self._publish(state, output, now_ns, now_ns)
         if self.node.markers_enabled and self.marker_pub.get_subscription_count() > 0:
@@ -645,9 +686,10 @@ class _Hand:
         force: Sequence[float],
         received: Any,
     ) -> None:
-        """Step every contact of the command to its stamp and publish one HandState, or reject
-        it (no contact changes, one ContactEvent on ``hand/events`` with the reason).
-        ``received``: the command as it came, a message object or its CDR payload, for the log."""
+        """Step every contact of the command to its stamp (or the latest of their times when
+        later) and publish one HandState stamped with that time, or reject it (no contact
+        changes, one ContactEvent on ``hand/events`` with the reason). ``received``: the command
+        as it came, a message object or its CDR payload, for the log."""
         node = self.node
         try:
             contacts = self._contacts(ids)
@@ -698,15 +740,17 @@ class _Hand:
         culprit = ""
         try:
             values = self._values(mode, depth, force, contacts)
-            epochs, stamps, targets = [], [], []
+            stamp_ns = 0
             for contact in contacts:
                 culprit = contact.id
                 stamp_ns = contact._command_stamp_locked(sec, nanosec, now_ns)
-                epoch_ns = stamp_ns if contact.last_command_ns is None else contact.epoch_ns
-                epochs.append(epoch_ns)
-                stamps.append(stamp_ns)
-                targets.append(max((stamp_ns - epoch_ns) * 1e-9, contact.simulator.time))
             culprit = ""
+            # One time for the whole sample: the stamp, or the latest of the contacts' times
+            # when one is later (see _Contact._applied_ns), so HandState's one stamp is the time
+            # every row describes and no contact's time goes back.
+            at_ns = max(contact._applied_ns(stamp_ns) for contact in contacts)
+            epochs = [at_ns if c.last_command_ns is None else c.epoch_ns for c in contacts]
+            targets = [(at_ns - epoch_ns) * 1e-9 for epoch_ns in epochs]
             started = time.perf_counter()
             outputs = step_contacts([c.simulator for c in contacts], targets, mode, values)
             spent = (time.perf_counter() - started) / len(contacts)
@@ -723,12 +767,12 @@ class _Hand:
             self._reject(reason, culprit, index, Time(sec=sec, nanosec=nanosec), now_ns)
             return
         key = "depth" if mode == HandCommand.DEPTH else "force"
-        for contact, epoch_ns, stamp_ns, value in zip(contacts, epochs, stamps, values, strict=True):
+        for contact, epoch_ns, value in zip(contacts, epochs, values, strict=True):
             contact.counters.steps.add(spent)
-            contact.accepted_locked(epoch_ns, stamp_ns, now_ns, {key: float(value)}, count=False)
+            contact.accepted_locked(epoch_ns, stamp_ns, at_ns, now_ns, {key: float(value)}, count=False)
         self.commands_received += 1
         payload = cdr.pack_hand_state(
-            stamps[0],
+            at_ns,
             node.frame_id,
             [c.id for c in contacts],
             _hand_columns(outputs, [c.simulator.model for c in contacts]),
