@@ -94,7 +94,9 @@ def test_deep_cone_pull_off_by_preset() -> None:
 
     case = dataclasses.replace(next(c for c in convergence_cases.CASES if c.name == "cone"), depth=300.0)
     times, depths = case.history()
-    reference = simulate_history(case.contact(preset="accurate", elements=2048), times, depth=depths).force.min()
+    reference = simulate_history(
+        case.contact(preset="accurate", elements=2048), times, depth=depths
+    ).force.min()
     for name, bound in (("fast", 0.012), ("balanced", 0.0015), ("accurate", 0.001)):
         pull_off = simulate_history(case.contact(preset=name), times, depth=depths).force.min()
         assert abs(pull_off / reference - 1.0) <= bound, (name, pull_off, reference)

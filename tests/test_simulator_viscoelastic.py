@@ -249,7 +249,9 @@ def _fine_retraction(sim: ContactSimulator, speed: float, duration: float, rows:
     ],
     ids=["deep cone closed form", "deep cone glassy", "glassy sphere"],
 )
-def test_predict_pull_off_finds_a_branch_narrower_than_its_rows(indenter, kelvin, viscosities, depth, model) -> None:
+def test_predict_pull_off_finds_a_branch_narrower_than_its_rows(
+    indenter, kelvin, viscosities, depth, model
+) -> None:
     """The model path is forced (`model`) so each case runs the path it names. Against the
     same retraction stepped in 400,000 rows: the pull-off within 1e-3 of itself and the let-go
     within 1e-4 of the time retracted."""
@@ -273,7 +275,9 @@ def test_predict_pull_off_finds_a_branch_narrower_than_its_rows(indenter, kelvin
     assert abs(prediction.time_to_detach - gone) <= 1e-4 * gone, (prediction.time_to_detach, gone)
 
 
-@pytest.mark.parametrize(("press", "hold", "speed"), [(50e-6, 0.2, 2e-3), (5e-6, 0.5, 1e-4), (20e-6, 2.0, 1e-3)])
+@pytest.mark.parametrize(
+    ("press", "hold", "speed"), [(50e-6, 0.2, 2e-3), (5e-6, 0.5, 1e-4), (20e-6, 2.0, 1e-3)]
+)
 def test_predict_pull_off_time_to_detach_is_the_let_go(press, hold, speed) -> None:
     """`time_to_detach` was the end of the prediction's row that let go: 3-6 % late on the
     default scene (outside tester, 0.8.0). Against the same retraction in rows 20,000 times
