@@ -867,11 +867,21 @@ class _TimeStepped:
         self._edge = result[7]
         self._edge_depth = d1
         self._force_at = (row, radius, d1, result[2])
+
+    def prepare_ahead(self) -> None:
+        """After a public step: one slice of the next domain's geometry when the contact has
+        passed PREPARE_FRACTION of its domain (`_prepare_growth`). Once per step, not per
+        kernel call: a force search's trials each prepared a slice, so a zero force from rest
+        (4 snap-in trials) computed and built the whole next domain inside its one step
+        (0.8.0). Changes no output (the geometry is a pure function of the length)."""
+        row = self.row
+        if row is None:
+            return
         if row is not self._prepare_row:
             # A new row (a growth in this step: its next domain is prepared from the next step).
             self._prepare_row = row
             self._prepare_radius = PREPARE_FRACTION * row.length
-        elif radius > self._prepare_radius:
+        elif self.radius > self._prepare_radius:
             self._prepare_growth(row)
 
     def advance_rows(
@@ -1854,6 +1864,7 @@ class ContactSimulator:
                 trials.clear()
                 output = self._search_force(t, target, start, last, trials)
                 self._held_force = target
+                model.prepare_ahead()
                 return output
             # `_publish` of the trial at the root (the model is in its state).
             energy = energy0 + result[3]
@@ -1878,6 +1889,7 @@ class ContactSimulator:
             self._output = output
             self._remember(output, before, trials, d0, f0, dt, None, slope)
             self._held_force = target
+            model.prepare_ahead()
             return output
         except BaseException:
             model.rollback(token)
@@ -1889,7 +1901,10 @@ class ContactSimulator:
         """`step` on the general path: validation, then `_step` as a transaction."""
         saved = self._undo_token()
         try:
-            return self._step(time, depth, force)
+            output = self._step(time, depth, force)
+            if self._lean:
+                self._model.prepare_ahead()
+            return output
         except BaseException:
             self._undo(saved)
             raise
