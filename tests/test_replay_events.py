@@ -64,7 +64,8 @@ class NodeRules:
         wrench = conversions.wrench(output, stamp_ns=stamp_ns, frame_id="contact")
         self.rec.record("/finger/wrench", wrench, now_ns)
         self.forces.append(output.force)
-        self.time = stamp_ns
+        if self.last_command is not None:
+            self.time = stamp_ns  # a rest heartbeat before the first command sets no time
 
     def _event(self, kind: int, now_ns: int, **fields: Any) -> None:
         if not self.events:
@@ -179,8 +180,8 @@ def _session(path: Path, *, events: bool = True) -> tuple[list[float], dict[str,
             node.reset(t)
             node.tick(t + 20 * MS)
             node.tick(t + 40 * MS)
-            # The first command after the reset, stamped before the rest heartbeat it arrives
-            # after: its history starts at the heartbeat's time.
+            # The first command after the reset, stamped before the rest heartbeats it arrives
+            # after: its history starts at its own stamp (a heartbeat describes no history).
             node.command(t + 41 * MS, t + 30 * MS, depth=-2e-6)
             # The same cycle again, then a parameter change once idle, ticks, a third cycle.
             end = _cycle(node, t + 100 * MS)
@@ -237,8 +238,8 @@ def test_replay_reproduces_rejections_reset_and_parameter_change(
     assert [s.commands_received for s in states] == list(range(1, counts["accepted"] + 1))
     assert states[0].commands_rejected == 0 and states[-1].commands_rejected == counts["rejected"]
     assert states[3].commands_rejected == 3, "NaN, unknown mode and older stamp before the 4th"
-    # ... stamped as the node stamped its answers: a command stamped before a hold tick (or a
-    # rest heartbeat) it arrived after, at the tick's time (the 0.8.0 replay used its stamp).
+    # ... stamped as the node stamped its answers: a command stamped before a hold tick it
+    # arrived after, at the tick's time (the 0.8.0 replay used its stamp).
     stamps = [conversions.stamp_to_ns(s.header.stamp) for s in states]
     assert stamps == answers
 

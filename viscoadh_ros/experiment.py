@@ -20,7 +20,7 @@ Two orders of events:
   runs in recording order, which is the order the node
   handled things in: it logs each command on receipt, before its answer, and its hold-timer
   states as it publishes them. A command stamped before a state the node already published
-  for the contact (a hold tick's, a rest heartbeat's) runs at that state's time, as the node
+  for the contact since its history began (a hold tick's) runs at that state's time, as the node
   applied (and stamped) it. The node's verdicts are applied as the node made them: a
   command refused by the node (a ``COMMAND_REJECTED`` ``ContactEvent`` on ``C/events`` naming
   its index among the commands received; or, in logs without events, what the node always
@@ -563,14 +563,21 @@ def _applied_ns(
     state_ns, state_order = _stamps_of(bag, published)
     values = np.concatenate([stamps, state_ns])
     orders = np.concatenate([order, state_order])
+    is_command = np.arange(values.size) < stamps.size
     by_order = np.argsort(orders, kind="stable")
-    values, orders = values[by_order], orders[by_order]
-    # A restart (reset, parameter change, clock jump back) forgets the contact's time.
+    values, orders, is_command = values[by_order], orders[by_order], is_command[by_order]
+    # A restart (reset, parameter change, clock jump back) forgets the contact's time, and the
+    # rest heartbeats before its first command describe no history (the node does not count
+    # them: the first command starts one at its own stamp).
     segment = np.searchsorted(np.array([r.order for r in restarts], dtype=np.int64), orders)
     running = np.empty_like(values)
     for seg in np.unique(segment).tolist():
         mine = np.flatnonzero(segment == seg)  # contiguous: sorted by order
-        running[mine] = np.maximum.accumulate(values[mine])
+        mine_values = values[mine].copy()
+        commands = np.flatnonzero(is_command[mine])
+        first = int(commands[0]) if commands.size else mine.size
+        mine_values[:first] = np.iinfo(np.int64).min
+        running[mine] = np.maximum.accumulate(mine_values)
     applied = np.empty_like(running)
     applied[by_order] = running
     return applied[: stamps.size]

@@ -340,9 +340,10 @@ class _Contact:
 
     def _applied_ns(self, stamp_ns: int) -> int:
         """When a command stamped ``stamp_ns`` applies: at its stamp, or at the contact's time
-        when that is later (a hold tick, or before the first command a rest heartbeat, already
-        published a state stamped after it), so the contact's time and the stamps of its states
-        never go back. Its state is stamped with this time, the time it describes."""
+        when that is later (a hold tick or a command already published a state stamped after
+        it), so the contact's time and the stamps of its states never go back within a history.
+        The first command since start or a restart starts a history at its own stamp (rest
+        heartbeats before it describe none). Its state is stamped with this time."""
         return stamp_ns if self.time_ns is None else max(stamp_ns, self.time_ns)
 
     def accepted_locked(
@@ -436,7 +437,10 @@ class _Contact:
                     return
                 self.counters.steps.add(time.perf_counter() - started)
             self.last_publish_ns = now_ns
-            self.time_ns = now_ns
+            if self.last_command_ns is not None:
+                # A rest heartbeat before the first command describes no history: the first
+                # command starts one at its own stamp (tests/test_node_faults.py).
+                self.time_ns = now_ns
             state = self._state_locked(output, now_ns)
         self._publish(state, output, now_ns, now_ns)
         if self.node.markers_enabled and self.marker_pub.get_subscription_count() > 0:
