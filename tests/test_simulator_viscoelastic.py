@@ -237,27 +237,32 @@ def _fine_retraction(sim: ContactSimulator, speed: float, duration: float, rows:
 
 
 @pytest.mark.parametrize(
-    ("indenter", "kelvin", "viscosities", "depth", "model"),
+    ("indenter", "glass", "kelvin", "viscosities", "depth", "model"),
     [
         # A deep press of a blunt cone: the prediction's rows (1/400 of the depth) were wider
         # than the whole adhesive branch, so no row was tensile: 0 N (outside tester, 0.8.0).
-        ({"shape": "cone", "half_angle": math.radians(85.0)}, (), (), 1e-3, "closed_form"),
-        ({"shape": "cone", "half_angle": math.radians(85.0)}, (5e4,), (1e9,), 1e-3, "time_stepped"),
+        ({"shape": "cone", "half_angle": math.radians(85.0)}, 1e6, (), (), 1e-3, "closed_form"),
+        ({"shape": "cone", "half_angle": math.radians(85.0)}, 1e6, (5e4,), (1e9,), 1e-3, "time_stepped"),
         # A glassy pad (G0 / G1 = 1e4, creep time 1e6 s) pressed 5 um: the rows' range scales
         # with E0* / E_r*, so the first row already let go: 0 N and a detach time 16x late.
-        ({"shape": "sphere", "radius": 5e-3}, (1e2,), (1e8,), 5e-6, "time_stepped"),
+        ({"shape": "sphere", "radius": 5e-3}, 1e6, (1e2,), (1e8,), 5e-6, "time_stepped"),
+        # G0 / G1 = 1e12: the zoom stopped after 8 levels, short of the branch: 0 N again
+        # (a second outside tester, 0.9.0). Glassy for 1e15 s: an elastic JKR pull-off,
+        # -(3/2) pi R w, which 400,000 rows miss by 3 % (1e6 rows: within 3e-4); the force is
+        # compared with that limit instead.
+        ({"shape": "sphere", "radius": 5e-3}, 1e12, (1.0,), (1e15,), 5e-6, "time_stepped"),
     ],
-    ids=["deep cone closed form", "deep cone glassy", "glassy sphere"],
+    ids=["deep cone closed form", "deep cone glassy", "glassy sphere", "very glassy sphere"],
 )
 def test_predict_pull_off_finds_a_branch_narrower_than_its_rows(
-    indenter, kelvin, viscosities, depth, model
+    indenter, glass, kelvin, viscosities, depth, model
 ) -> None:
     """The model path is forced (`model`) so each case runs the path it names. Against the
-    same retraction stepped in 400,000 rows: the pull-off within 1e-3 of itself and the let-go
-    within 1e-4 of the time retracted."""
+    same retraction stepped in 400,000 rows (the very glassy pad's force: its JKR limit): the
+    pull-off within 1e-3 of itself and the let-go within 1e-4 of the time retracted."""
     contact = one_contact(
         indenter,
-        glass_shear_modulus=1e6,
+        glass_shear_modulus=glass,
         kelvin=kelvin,
         viscosities=viscosities,
         work=0.05,
@@ -269,9 +274,36 @@ def test_predict_pull_off_finds_a_branch_narrower_than_its_rows(
     speed = 1e-3
     prediction = predict_pull_off(sim, retract_speed=speed)
     force, gone = _fine_retraction(sim, speed, (depth + 2e-5) / speed, 400_000)
+    if glass > 1e9:
+        force = -1.5 * math.pi * indenter["radius"] * 0.05
     assert prediction.detached
     assert force < 0.0
     assert abs(prediction.pull_off_force - force) <= 1e-3 * abs(force), (prediction.pull_off_force, force)
+    assert abs(prediction.time_to_detach - gone) <= 1e-4 * gone, (prediction.time_to_detach, gone)
+
+
+def test_predict_pull_off_finds_the_cusp_of_a_fast_let_go_after_a_deep_press() -> None:
+    """A power law (n = 1.5) pressed 1 mm into the default pad, held 10 s, retracted at 1 m/s:
+    the largest pull is a cusp 0.6 um before the let-go, which rows 16x finer than the
+    prediction's missed as well and rows 256x finer found: the prediction was 1.9 % short (a
+    second outside tester, 0.9.0). Against the same retraction in 400,000 rows: within 1e-4."""
+    contact = one_contact(
+        {"shape": "power_law", "coefficient": 1e2, "exponent": 1.5},
+        glass_shear_modulus=1e6,
+        kelvin=(5e4,),
+        viscosities=(1.05e5,),
+        work=0.05,
+        numerics={"model": "time_stepped"},
+    )
+    sim = ContactSimulator(contact)
+    depth = 1e-3
+    sim.step_depths(np.linspace(1e-3, 0.05, 50), np.linspace(depth / 50, depth, 50))
+    sim.step(10.05, depth=depth)
+    speed = 1.0
+    prediction = predict_pull_off(sim, retract_speed=speed)
+    force, gone = _fine_retraction(sim, speed, 1.937 * prediction.time_to_detach, 400_000)
+    assert prediction.detached
+    assert abs(prediction.pull_off_force - force) <= 1e-4 * abs(force), (prediction.pull_off_force, force)
     assert abs(prediction.time_to_detach - gone) <= 1e-4 * gone, (prediction.time_to_detach, gone)
 
 
