@@ -121,6 +121,22 @@ class Experiment:
     commands_before: int = 0
     rejected_before: int = 0
 
+    def select(self, inputs: Any, measured: Any, **changes: Any) -> Experiment:
+        """This record with only the inputs ``inputs`` and the measured samples ``measured``
+        (masks or index arrays over each), and the fields in ``changes`` replaced."""
+        return dataclasses.replace(
+            self,
+            input_ns=self.input_ns[inputs],
+            input_order=self.input_order[inputs],
+            input_mode=self.input_mode[inputs],
+            input_value=self.input_value[inputs],
+            input_index=None if self.input_index is None else self.input_index[inputs],
+            measured_ns=self.measured_ns[measured],
+            measured_force=self.measured_force[measured],
+            measured_order=self.measured_order[measured],
+            **changes,
+        )
+
     def time(self, ns: NDArray[np.int64]) -> NDArray[np.float64]:
         """Seconds since the first input."""
         return (np.asarray(ns, dtype=np.int64) - self.t0_ns) * 1e-9
@@ -817,18 +833,8 @@ def stretch(experiment: Experiment, after: int | None, before: int | None) -> Ex
         measured &= experiment.measured_order > int(experiment.input_order[inputs].min())
     else:
         measured &= experiment.measured_ns >= int(experiment.input_ns[inputs].min())
-    return dataclasses.replace(
-        experiment,
-        input_ns=experiment.input_ns[inputs],
-        input_order=experiment.input_order[inputs],
-        input_mode=experiment.input_mode[inputs],
-        input_value=experiment.input_value[inputs],
-        input_index=None if experiment.input_index is None else experiment.input_index[inputs],
-        measured_ns=experiment.measured_ns[measured],
-        measured_force=experiment.measured_force[measured],
-        measured_order=experiment.measured_order[measured],
-        restarts=tuple(r for r in experiment.restarts if low < r.order < high),
-    )
+    restarts = tuple(r for r in experiment.restarts if low < r.order < high)
+    return experiment.select(inputs, measured, restarts=restarts)
 
 
 def _at_rest(contact: ContactConfig, index: NDArray[np.int64], model_force: NDArray[np.float64]) -> None:

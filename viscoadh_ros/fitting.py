@@ -584,19 +584,7 @@ def coarse_record(experiment: Experiment, picked: NDArray[np.bool_], every: int)
         kept = np.unique(np.concatenate([kept, *fill]))
     if kept.size >= n:
         return experiment
-    return dataclasses.replace(
-        experiment,
-        input_ns=experiment.input_ns[kept],
-        input_order=experiment.input_order[kept],
-        input_mode=experiment.input_mode[kept],
-        input_value=experiment.input_value[kept],
-        input_index=None if experiment.input_index is None else experiment.input_index[kept],
-        measured_ns=experiment.measured_ns[picked],
-        measured_force=experiment.measured_force[picked],
-        measured_order=experiment.measured_order[picked],
-        rejected_index=np.empty(0, dtype=np.int64),
-        rejected_reason=(),
-    )
+    return experiment.select(kept, picked, rejected_index=np.empty(0, dtype=np.int64), rejected_reason=())
 
 
 def by_retardation(values: dict[str, float], kelvin: int) -> dict[str, float]:
