@@ -308,6 +308,10 @@ def _write_output(
             raise KeyError(str(run.input_model[np.flatnonzero(~known)[0]]))
     state = {**columns, "model": model, "commands_received": received, "commands_rejected": rejected}
     frame = scene.node.frame_id
+    # The records' log times never go back, so the file keeps the run order where the stamps go
+    # back (a new time origin after a reset or a clock jump back in a node log); the headers keep
+    # the stamps. In stamp order the two histories' rows alternated in the file.
+    logged = np.maximum.accumulate(stamps) if stamps.size else stamps
     if path.exists():
         path.unlink()
     write_columns(
@@ -316,13 +320,13 @@ def _write_output(
             TopicData(
                 f"/{contact_id}/state",
                 cdr.CONTACT_STATE,
-                stamps,
+                logged,
                 cdr.Messages(cdr.CONTACT_STATE, stamps, frame, state),
             ),
             TopicData(
                 f"/{contact_id}/wrench",
                 cdr.WRENCH,
-                stamps,
+                logged,
                 cdr.Messages(cdr.WRENCH, stamps, frame, {"wrench.force.z": columns["force"]}),
             ),
         ],
