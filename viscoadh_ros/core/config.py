@@ -167,7 +167,7 @@ class ContactConfig:
 class NodeConfig:
     """Node-wide settings (flat keys in brackets).
 
-    publish_rate [publish_rate]: state publication rate between commands, Hz (> 0).
+    publish_rate [publish_rate]: state publication rate between commands, Hz (0.1..10000).
     frame_id [frame_id]: frame of published states, wrenches and markers.
     markers_enabled [markers.enabled]: publish ``C/marker``.
     log_enabled [log.enabled], log_path [log.path]: MCAP logging and its file/folder.
@@ -491,10 +491,20 @@ def _build_contact(contact_id: str, given: dict[str, Any]) -> ContactConfig:
     )
 
 
+#: The node's hold-timer rate, Hz: the range its ROS parameter descriptor declares (ros/parameters.py);
+#: a scene file is checked against the same (0.8.0 took any rate > 0 from a file: 1e9 Hz would
+#: spin a timer every nanosecond).
+PUBLISH_RATE_MIN, PUBLISH_RATE_MAX = 0.1, 10_000.0
+
+
 def _build_node(given: dict[str, Any]) -> NodeConfig:
     node = NodeConfig(**{key.replace(".", "_"): value for key, value in given.items()})
     checks = [
-        ("publish_rate", node.publish_rate > 0.0, "> 0"),
+        (
+            "publish_rate",
+            PUBLISH_RATE_MIN <= node.publish_rate <= PUBLISH_RATE_MAX,
+            f"in [{PUBLISH_RATE_MIN:g}, {PUBLISH_RATE_MAX:g}] Hz",
+        ),
         ("log.chunk_size", node.log_chunk_size > 0, "> 0"),
         ("log.max_bytes", node.log_max_bytes >= 0, ">= 0"),
         ("log.max_duration", node.log_max_duration >= 0.0, ">= 0"),

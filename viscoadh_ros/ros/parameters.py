@@ -34,6 +34,8 @@ from viscoadh_ros.core.config import (
     COMMAND_QUEUE_DEPTH_MAX,
     CONTACT_KEYS,
     NODE_KEYS,
+    PUBLISH_RATE_MAX,
+    PUBLISH_RATE_MIN,
     SceneConfig,
     load_default_scene,
     read_yaml,
@@ -157,8 +159,8 @@ _NODE_SPECS: dict[str, _Spec] = {
     ),
     "publish_rate": _Spec(
         "Rate of the state published between commands (hold, relaxation), Hz.",
-        low=0.1,
-        high=10_000.0,
+        low=PUBLISH_RATE_MIN,
+        high=PUBLISH_RATE_MAX,
     ),
     "frame_id": _Spec(
         "frame_id of published states, wrenches and markers: the contact frame, z from the body "
