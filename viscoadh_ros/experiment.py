@@ -323,7 +323,7 @@ def load_experiment(
         # The node applies a command stamped before the contact's last published state at that
         # state's time (and stamps its answer so): run each input at the time the node did.
         stamps = stamps.copy()
-        stamps[run] = _applied_ns(bag, inputs, stamps[run], order[run], restarts)
+        stamps[run] = _applied_ns(bag, inputs, stamps[run], order[run], restarts, counts)
     else:
         _refuse_mid_history(bag, inputs, order, earlier, ())
         bad = np.flatnonzero((mode != DEPTH) & (mode != FORCE))
@@ -416,6 +416,7 @@ class _StateCounts:
     order: NDArray[np.int64]  # positions of the states in the recording
     received: NDArray[np.int64]  # commands_received (accepted)
     rejected: NDArray[np.int64]  # commands_rejected
+    stamp_ns: NDArray[np.int64]  # header stamps as published (the time each state describes)
 
 
 def _state_counts(bag: Bag, inputs: str) -> _StateCounts | None:
@@ -431,6 +432,7 @@ def _state_counts(bag: Bag, inputs: str) -> _StateCounts | None:
         order.astype(np.int64),
         columns["commands_received"].astype(np.int64),
         columns["commands_rejected"].astype(np.int64),
+        columns["stamp_ns"].astype(np.int64),
     )
 
 
@@ -566,17 +568,25 @@ def _applied_ns(
     stamps: NDArray[np.int64],
     order: NDArray[np.int64],
     restarts: tuple[Restart, ...],
+    counts: _StateCounts | None,
 ) -> NDArray[np.int64]:
     """The time the node applied each accepted command at (``stamps``, ``order``: the accepted
     commands in recording order): its stamp, or the contact's time when that is later, the
     stamp of the last state it published (``C/state``, else ``C/wrench``, beside ``inputs``)
     or of a command it applied, since the last restart before it (ros/node.py
-    ``_Contact._applied_ns``). The stamps as they are when the log holds neither topic."""
+    ``_Contact._applied_ns``). The stamps as they are when the log holds neither topic.
+    ``counts``: the states' counters and stamps when `_state_counts` read them already."""
     base = inputs.rsplit("/", 1)[0]
     published = next((t for t in (base + "/state", base + "/wrench") if t in bag.topics), None)
     if published is None:
         return stamps
-    state_ns, state_order = _stamps_of(bag, published)
+    if counts is not None and published == base + "/state":
+        state_ns, state_order = counts.stamp_ns, counts.order
+    else:
+        # The header stamps as published (`_read_topic`'s own stamps put the log time for a
+        # zero one).
+        _, state_order, columns = _read_topic(bag, published, ())
+        state_ns = columns.get("stamp_ns", np.zeros(0, np.int64))
     values = np.concatenate([stamps, state_ns])
     orders = np.concatenate([order, state_order])
     is_command = np.arange(values.size) < stamps.size
@@ -597,20 +607,6 @@ def _applied_ns(
     applied = np.empty_like(running)
     applied[by_order] = running
     return applied[: stamps.size]
-
-
-def _stamps_of(bag: Bag, topic: str) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
-    """``(header stamp ns, order)`` of every message of the stamped ``topic``."""
-    log_ns, order, rows = bag.rows(topic)
-    columns = None if rows is None else cdr.decode(bag.topics[topic], rows, ())
-    if columns is not None and "stamp_ns" in columns:
-        return columns["stamp_ns"], order
-    messages = list(bag.messages([topic]))
-    stamp_ns = np.array(
-        [m.msg.header.stamp.sec * 1_000_000_000 + m.msg.header.stamp.nanosec for m in messages],
-        dtype=np.int64,
-    )
-    return stamp_ns, np.array([m.order for m in messages], dtype=np.int64)
 
 
 def _node_verdicts(
