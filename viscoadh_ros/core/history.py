@@ -183,12 +183,12 @@ def predict_pull_off(simulator: ContactSimulator, retract_speed: float) -> PullO
     best = [min(out.force, 0.0), out.depth, -1.0, 0]
     levels: list[tuple[Any, float, float]] = [(start, 0.0, dt)]
 
-    def rows_from(level: int, count: int, skip: int = 0) -> int:
-        """`count` rows of level `level` after its first `skip` rows; the first detached
-        row's index (1-based), 0 if none."""
+    def rows_from(level: int, count: int) -> int:
+        """The first `count` rows of level `level`; the first detached row's index (1-based),
+        0 if none."""
         origin, ta, h = levels[level]
         simulator.restore(origin)
-        for k in range(1, skip + count + 1):
+        for k in range(1, count + 1):
             t = ta + k * h
             step = simulator.step(t0 + t, depth=d0 - speed * t)
             if step.force < best[0]:

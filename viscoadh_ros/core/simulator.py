@@ -1640,6 +1640,7 @@ class ContactSimulator:
                             model._edge = edge
                             model._edge_depth = d
                             model._force_at = (row, radius, d, f)
+                            # `_TimeStepped.prepare_ahead`, inline (a call costs this path).
                             if row is not model._prepare_row:
                                 model._prepare_row = row
                                 model._prepare_radius = PREPARE_FRACTION * row.length
