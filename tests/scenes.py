@@ -1,4 +1,4 @@
-"""Scene builders shared by the simulator tests.
+"""Scene builders shared by the simulator tests, and `call_service` for the node tests.
 
 Every test contact goes through the one scene loader (`SceneConfig.from_dict`), so the tests
 exercise the same validation and defaults a user's YAML file does.
@@ -6,6 +6,7 @@ exercise the same validation and defaults a user's YAML file does.
 
 from __future__ import annotations
 
+import time
 from collections.abc import Sequence
 from typing import Any
 
@@ -69,3 +70,15 @@ def node_contacts_scene(count: int, *, radius_spread: float = 0.0, **node: Any) 
         scene[f"{contact_id}.adhesion.work_of_adhesion"] = 0.05
         scene[f"{contact_id}.numerics.preset"] = "fast"
     return scene
+
+
+def call_service(client: Any, request: Any, timeout: float = 10.0) -> Any:
+    """The response of ``client`` (an rclpy service client whose node another thread spins,
+    e.g. `demo.node_in_process`'s executor) to ``request``; fails the test after ``timeout`` s."""
+    assert client.wait_for_service(timeout_sec=timeout)
+    future = client.call_async(request)
+    deadline = time.monotonic() + timeout
+    while not future.done() and time.monotonic() < deadline:
+        time.sleep(0.005)
+    assert future.done()
+    return future.result()

@@ -24,7 +24,7 @@ from rcl_interfaces.msg import ParameterType, ParameterValue
 from rcl_interfaces.srv import SetParameters
 from rclpy.node import Node
 from rosgraph_msgs.msg import Clock
-from scenes import STANDARD_SOLID_FINGER
+from scenes import STANDARD_SOLID_FINGER, call_service
 from std_srvs.srv import Trigger
 
 from viscoadh_ros.cli.main import main
@@ -39,16 +39,6 @@ SCENE = SceneConfig.from_parameters(STANDARD_SOLID_FINGER)
 #: Press to 20 um in 0.2 s, pull out to -30 um by 0.5 s, commands every 10 ms.
 TIMES = np.arange(0.0, 0.5, 0.01)
 DEPTHS = np.interp(TIMES, [0.0, 0.2, 0.5], [-1e-6, 20e-6, -30e-6])
-
-
-def _call(client: Any, request: Any) -> Any:
-    assert client.wait_for_service(timeout_sec=10.0)
-    future = client.call_async(request)
-    deadline = time.monotonic() + 10.0
-    while not future.done() and time.monotonic() < deadline:
-        time.sleep(0.005)
-    assert future.done()
-    return future.result()
 
 
 @pytest.fixture(scope="module")
@@ -85,7 +75,7 @@ def node_log(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
         move_clock(1.0)
         cycle(1.0)
-        assert _call(reset, Trigger.Request()).success
+        assert call_service(reset, Trigger.Request()).success
         idle(2.1)
         cycle(11.0)
         change = SetParameters.Request(
@@ -96,11 +86,11 @@ def node_log(tmp_path_factory: pytest.TempPathFactory) -> Path:
                 )
             ]
         )
-        result = _call(parameters, change).results[0]
+        result = call_service(parameters, change).results[0]
         assert result.successful, result.reason
         idle(12.1)
         cycle(21.0)
-        assert _call(reset, Trigger.Request()).success
+        assert call_service(reset, Trigger.Request()).success
         idle(22.1)
         cycle(31.0)
     return log

@@ -12,7 +12,6 @@ import json
 import threading
 import time
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 import pytest
@@ -21,7 +20,7 @@ from rcl_interfaces.msg import ParameterType, ParameterValue
 from rcl_interfaces.srv import SetParameters
 from rclpy.node import Node
 from rosgraph_msgs.msg import Clock
-from scenes import STANDARD_SOLID_FINGER
+from scenes import STANDARD_SOLID_FINGER, call_service
 from std_srvs.srv import Trigger
 from viscoadh_msgs.msg import ContactEvent, ContactState, IndentationCommand
 
@@ -101,15 +100,6 @@ class _Session:
         self._wait_events(count + 1)
         assert self.events[-1].kind == ContactEvent.COMMAND_REJECTED
 
-    def call(self, client: Any, request: Any) -> Any:
-        assert client.wait_for_service(timeout_sec=10.0)
-        future = client.call_async(request)
-        deadline = time.monotonic() + 10.0
-        while not future.done() and time.monotonic() < deadline:
-            time.sleep(0.005)
-        assert future.done()
-        return future.result()
-
     def cycle(self, start: float) -> None:
         for t, d in zip(TIMES, DEPTHS, strict=True):
             self.driver.command(start + t, d)
@@ -144,7 +134,7 @@ def node_log(tmp_path_factory: pytest.TempPathFactory) -> Path:
         session.refused(1.008, depth=50e-6)  # older than the last command's stamp
         session.late(1.05, depth=1e-6, accepted=3)
         session.cycle(1.07)
-        assert session.call(session.reset_client, Trigger.Request()).success
+        assert call_service(session.reset_client, Trigger.Request()).success
         session._wait_events(4)
         session.cycle(3.0)
         change = SetParameters.Request(
@@ -155,7 +145,7 @@ def node_log(tmp_path_factory: pytest.TempPathFactory) -> Path:
                 )
             ]
         )
-        results = session.call(session.parameters, change).results
+        results = call_service(session.parameters, change).results
         assert results[0].successful, results[0].reason
         session._wait_events(5)
         session.cycle(5.0)

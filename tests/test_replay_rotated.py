@@ -24,7 +24,7 @@ import numpy as np
 import pytest
 from rclpy.node import Node
 from rosgraph_msgs.msg import Clock
-from scenes import node_contacts_scene
+from scenes import call_service, node_contacts_scene
 from std_srvs.srv import Trigger
 from viscoadh_msgs.msg import ContactEvent, IndentationCommand
 
@@ -82,13 +82,7 @@ class _Session:
         time.sleep(0.2)
 
     def reset(self, contact: str) -> None:
-        client = self.resets[contact]
-        assert client.wait_for_service(timeout_sec=10.0)
-        future = client.call_async(Trigger.Request())
-        deadline = time.monotonic() + 10.0
-        while not future.done() and time.monotonic() < deadline:
-            time.sleep(0.005)
-        assert future.done() and future.result().success
+        assert call_service(self.resets[contact], Trigger.Request()).success
 
 
 def _log(path: Path) -> None:
