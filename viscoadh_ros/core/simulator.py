@@ -378,6 +378,9 @@ class _ClosedForm:
     def rollback(self, token: float) -> None:
         self.radius = token
 
+    def prepare_ahead(self) -> None:
+        """Nothing to prepare after a step: the closed form has no domain."""
+
     def get_state(self) -> float:
         return self.radius
 
@@ -1903,8 +1906,7 @@ class ContactSimulator:
         saved = self._undo_token()
         try:
             output = self._step(time, depth, force)
-            if self._lean:
-                self._model.prepare_ahead()
+            self._model.prepare_ahead()
             return output
         except BaseException:
             self._undo(saved)
