@@ -230,7 +230,14 @@ def judge(trajectory: Trajectory) -> None:
     released = tr.release_step is not None
     if not tr.place:
         if tr.pick_step is None:
-            tr.outcome, tr.success = "not picked: the pads let go before the part left the table", False
+            rise = float(tr.part_rise.max()) if tr.part_rise.size else 0.0
+            if rise > 0.0:
+                where = f"the part rose {rise * 1e3:.3g} mm"
+            else:
+                where = "the part never left the table"
+            lift = f"{LIFT_THRESHOLD * 1e3:g} mm"
+            tr.outcome = f"not picked: the pads let go before the part was lifted {lift} ({where})"
+            tr.success = False
         elif released:
             tr.outcome = f"dropped in transport at t = {tr.release_time:.4f} s"
             tr.success = False
