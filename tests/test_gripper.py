@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 import subprocess
 import sys
+import warnings
 from dataclasses import replace
 
 import mujoco
@@ -168,6 +169,22 @@ def test_a_bad_gripper_key_is_one_clear_error(section, value, message):
     data["gripper"][section] = value
     with pytest.raises(ConfigError, match=message):
         cell_from_dict(data)
+
+
+def test_a_non_adhesive_pad_is_plotted_without_a_warning(tmp_path):
+    # Without adhesion the pads never pull: the force axis was limited to (0, 0), which
+    # matplotlib warns about (an outside tester, 0.9.0).
+    from viscoadh_ros.gripper.figures import plot_runs
+    from viscoadh_ros.gripper.scenarios import Run
+
+    data = raw_cell()
+    data["/**"]["ros__parameters"]["pad"]["adhesion"]["work_of_adhesion"] = 0.0
+    plain = cell_from_dict(data)
+    tr = run_cycle(plain, SHORT, LibraryPads(plain.pad, 1))
+    assert tr.force.min() >= 0.0
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert plot_runs([Run("no adhesion", tr)], tmp_path / "runs.png", title="t").exists()
 
 
 def test_pad_scene_has_one_contact_per_pad(cell):

@@ -38,7 +38,8 @@ def plot_runs(runs: list[Run], output: Path, *, title: str) -> Path:
                     ax.plot(tr.time[step], values[step], marker, color=colour, ms=8, mec="k")
     force_axis = axes[1]
     low = min(float(r.trajectory.force.sum(axis=1).min()) for r in runs) * 1e3
-    force_axis.set_ylim(low * 1.3, -low * 4.0)  # the press peaks far above: keep the pull readable
+    if low < 0.0:  # the press peaks far above: keep the pull readable
+        force_axis.set_ylim(low * 1.3, -low * 4.0)
     force_axis.axhline(0.0, color="k", lw=0.5)
     axes[0].legend(loc="upper left", fontsize=7, frameon=False)
     axes[0].set_title(
