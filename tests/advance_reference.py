@@ -14,6 +14,7 @@ import math
 import numba
 
 from viscoadh_ros.core._kernels import (
+    _adhesion_loss,
     _ATTEMPTS_PER_ELEMENT,
     _MAX_ATTEMPTS,
     _MAX_TOUCH_PLANS,
@@ -335,7 +336,7 @@ def advance_from_reference(
                 viscous,
                 peak,
             )
-        lost += viscous + max(hysteresis, 0.0)
+        lost += viscous + _adhesion_loss(hysteresis, a, new_a, max_edge_move)
         force_new = _force(new_a, db, wsum, bsum, dx, g_c, gf, gint, df, e0, kap, wsum[:0])
         work += 0.5 * (force_prev + force_new) * (db - da)
         force_prev = force_new

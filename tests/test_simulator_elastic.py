@@ -297,25 +297,34 @@ def test_energy_dissipated_never_decreases_under_force_control(model: str) -> No
 
 
 @pytest.mark.parametrize(
-    ("indenter", "bound"),
+    ("indenter", "deepest", "bound"),
     [
-        ({"shape": "cone", "half_angle": math.radians(85.0)}, 0.1),
-        ({"shape": "power_law", "coefficient": 0.5 / math.sqrt(R), "exponent": 1.5}, 0.04),
-        ({"shape": "sphere", "radius": R}, 0.01),
+        ({"shape": "cone", "half_angle": math.radians(85.0)}, 300.0, 0.02),
+        ({"shape": "cone", "half_angle": math.radians(85.0)}, 2400.0, 0.2),
+        ({"shape": "cone", "half_angle": math.radians(80.0)}, 240.0, 0.02),
+        ({"shape": "cone", "half_angle": math.radians(70.0)}, 240.0, 0.05),
+        ({"shape": "cone", "half_angle": math.radians(70.0)}, 2400.0, 0.05),
+        ({"shape": "power_law", "coefficient": 0.5 / math.sqrt(R), "exponent": 1.5}, 300.0, 0.01),
+        ({"shape": "sphere", "radius": R}, 300.0, 0.01),
     ],
-    ids=["blunt cone", "power law 1.5", "sphere"],
+    ids=["blunt cone", "blunt cone 2400", "cone 80", "steep cone 70", "steep cone 70 2400", "power law 1.5", "sphere"],
 )
-def test_deep_cycle_dissipates_the_jkr_losses(indenter, bound) -> None:
-    """Pressed from -0.5 d_c to 300 d_c and pulled to -3 d_c in 1000 rows (d_c of the sphere),
-    `balanced`: the time-stepped path (forced) against the closed form's exact losses (the JKR
-    jumps), relative to those losses. At pull-off the domain's elements (sized for the deepest
-    point) are wider than the contact: counted per element the let-go lost 6.5x the exact loss
-    on the cone and 2 % more on the power law, and a fold smaller than an element was not
-    located in time (an outside tester, 0.8.0). The energy put in is not compared: it is a
-    trapezoid of the forces, whose error here is ~10x these losses (docs/concepts.md)."""
+def test_deep_cycle_dissipates_the_jkr_losses(indenter, deepest, bound) -> None:
+    """Pressed from -0.5 d_c to `deepest` d_c and pulled to -3 d_c in 1000 rows (d_c of the
+    sphere), `balanced`: the time-stepped path (forced) against the closed form's exact losses
+    (the JKR jumps), relative to those losses. At pull-off the domain's elements (sized for the
+    deepest point) are wider than the contact: counted per element the let-go lost 6.5x the
+    exact loss on the blunt cone and 2 % more on the power law, and a fold smaller than an
+    element was not located in time (an outside tester, 0.8.0). Every element the edge crossed
+    continuously counted the residue of its attach or release energy (cut at zero per
+    substep): +8 % on the blunt cone, +26 % at 80 degrees, +114 % at 70 degrees and 4.6x and
+    79x the loss pressed to 2400 d_c (an outside tester, 0.9.0; `_kernels._adhesion_loss`).
+    Measured in 0.10.0: within 0.6 % but the blunt cone at 2400 d_c, 3.4 %. The energy put in
+    is not compared: it is a trapezoid of the forces, whose error here is ~10x these losses
+    (docs/concepts.md)."""
     work = 0.05
     d_c = (3.0 * math.pi**2 * work**2 * R / (64.0 * E0**2)) ** (1.0 / 3.0)
-    depth = d_c * np.concatenate([np.linspace(-0.5, 300.0, 500), np.linspace(300.0, -3.0, 501)])
+    depth = d_c * np.concatenate([np.linspace(-0.5, deepest, 500), np.linspace(deepest, -3.0, 501)])
     times = np.linspace(0.0, 1.0, depth.size)
     lost = {}
     for model in MODELS:

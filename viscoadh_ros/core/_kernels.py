@@ -2055,6 +2055,27 @@ def _retime_crossed(
     return hysteresis
 
 
+@numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
+def _adhesion_loss(hysteresis, a0, a1, max_edge_move):
+    """The adhesion loss of a substep whose edge went from `a0` to `a1` (m), given the signed
+    hysteresis `_retime_crossed` computed for the elements it crossed, J.
+
+    Only a jump loses: a snap-in from no contact, a let-go to none, or an edge that moved
+    more than the motion limit `max_edge_move` in a substep of the shortest length (the fold
+    of a pull-off, a partial snap). An edge that moved continuously switched each element it
+    crossed where the criterion holds, and there the element's glass energy equals the
+    surface energy of its annulus: no loss in the model. What `_retime_crossed` computes for
+    such an element (its glass elongation at a switch depth interpolated linearly in time) is
+    a discretisation residue of either sign; cut at zero substep by substep it summed to
+    +27 % .. +111 % of the exact (JKR) loss of an elastic cycle pressed deep on a steep cone
+    at `balanced` (an outside tester, 0.9.0), and signed it was as large the other way.
+    0.10.0: continuous crossings lose nothing; a jump's hysteresis is cut at zero, as
+    before (the dissipated energy never falls)."""
+    if 0.0 < a0 and 0.0 < a1 and abs(a1 - a0) <= max_edge_move:
+        return 0.0
+    return max(hysteresis, 0.0)
+
+
 #: A let-go from a contact at most this many elements wide takes its loss on the fine profile
 #: (`_retime_crossed`, `_fold_energy`).
 FOLD_FINE_CELLS = 4
@@ -2980,7 +3001,7 @@ def _advance_from(
             if last:
                 t_lo = 0
                 t_hi = n
-        lost += viscous + max(hysteresis, 0.0)
+        lost += viscous + _adhesion_loss(hysteresis, a, new_a, max_edge_move)
         n_new = _interior_count(new_a, dx, n)
         if k_count and kap != 0.0 and t_lo > 0 and n_new > 0:
             # The force with the deferred block [0, t_lo) still at the step's start: its part
