@@ -8,8 +8,12 @@ substeps, `accurate` more and finer (measure the cost with `viscoadh bench`).
 Guaranteed errors on the time-stepped path, against an independent converged reference in
 every regime of the convergence study (tests/test_convergence.py, BENCHMARKS.md "Convergence
 against an independent reference": elastic, relaxed, partly relaxed, glassy and K = 3 bodies;
-sphere, cone and power-law indenters; 5 to 300 d_c deep; slow and fast retraction). Force
-errors are relative to the pull-off force (never to the peak compressive force):
+sphere, cone and power-law indenters; slow and fast retraction; elastic and glassy bodies 5 and
+300 d_c deep, viscoelastic ones with G0/G_inf <= 11 at most 12 relaxed d_c deep, 100 when
+relaxed, cones and power laws 5). Force errors are relative to the pull-off force (never to the
+peak compressive force). A larger G0/G_inf or a deeper viscoelastic press exceeds them (round 10:
+the paper's G0/G_inf = 101 at 10 relaxed d_c is 7.0e-2 at `balanced`; docs/configuration.md
+lists the measured exceptions):
 
     preset     pull-off   force on each branch   dissipated energy
     fast       0.5 %      7 %                    2 %
@@ -262,9 +266,10 @@ ERROR_MODEL: dict[str, tuple[tuple[float, float], ...]] = {
 #: grows with G0/G_inf and the depth. C = RATIO_TERM x G0/G_inf covers, with a 20 % margin,
 #: every history of `benchmarks/tolerance_depth.py` (sphere, G0/G_inf 1.1-1001, presses of 0.5-50
 #: retardation times) up to RATIO_DEPTH relaxed d_c deep whose peak force is at most
-#: RATIO_PEAK x G0/G_inf times its pull-off force (measured: 17.7 and 38 x G0/G_inf; beyond,
+#: RATIO_PEAK x G0/G_inf times its pull-off force (measured at most 17.7 x G0/G_inf for one
+#: element at G0/G_inf >= 11, 59 x for K = 3 at 19.3; beyond,
 #: see docs/configuration.md "Choosing numerics by tolerance").
-RATIO_TERM: dict[str, float] = {"viscoelastic": 22.0, "viscoelastic, K >= 2": 46.0}
+RATIO_TERM: dict[str, float] = {"viscoelastic": 22.0, "viscoelastic, K >= 2": 71.0}
 #: The depth (relaxed d_c of docs/concepts.md) and the peak-to-pull-off force ratio (over
 #: G0/G_inf) up to which RATIO_TERM was measured to hold.
 RATIO_DEPTH, RATIO_PEAK = 10.0, 4.0
