@@ -173,16 +173,21 @@ def check_tolerance(value: Any) -> float:
     return number
 
 
+#: G0/G_inf assumed when nothing is known of the scene (the largest of the K >= 2 measurements).
+UNKNOWN_RATIO = 101.0
+
+
 @dataclass(frozen=True)
 class SceneHint:
     """What the tolerance mode reads of a contact's scene (`ContactConfig` attaches it to its
     numerics, so `resolve_numerics` sees it): the relaxation times of the in-contact Kelvin
     chain, s (empty: elastic), the indenter shape and the glass-to-relaxed modulus ratio
-    G0/G_inf (1 for an elastic body), which scales the viscoelastic error (ERROR_MODEL)."""
+    G0/G_inf (1 for an elastic body), which scales the viscoelastic error (ERROR_MODEL);
+    a hint made without it (the 0.9.0 signature) assumes the conservative UNKNOWN_RATIO."""
 
     relaxation_times: tuple[float, ...]
     shape: str
-    relaxed_ratio: float
+    relaxed_ratio: float = UNKNOWN_RATIO
 
     @classmethod
     def of(cls, indenter: Any, material: Any) -> SceneHint:
@@ -273,8 +278,6 @@ RATIO_TERM: dict[str, float] = {"viscoelastic": 22.0, "viscoelastic, K >= 2": 71
 #: The depth (relaxed d_c of docs/concepts.md) and the peak-to-pull-off force ratio (over
 #: G0/G_inf) up to which RATIO_TERM was measured to hold.
 RATIO_DEPTH, RATIO_PEAK = 10.0, 4.0
-#: G0/G_inf assumed when nothing is known of the scene (the largest of the K >= 2 measurements).
-UNKNOWN_RATIO = 101.0
 #: A body counts as glassy over the time scale T when its shortest relaxation time is at least
 #: T / (GLASSY_FRACTION * tolerance): its memory then moves less than a tenth of the
 #: tolerance over T. Anything else viscoelastic takes the viscoelastic model (relaxed bodies
