@@ -5,7 +5,7 @@
 Why: the error model of numerics.tolerance (core/presets.py ERROR_MODEL) was fitted on the
 convergence study (tests/convergence_cases.py), whose viscoelastic bodies have G0/G_inf = 1.1
 and 11 and whose deepest viscoelastic press is ~12 relaxed d_c (300 glass-modulus units). An
-outside tester (round 10) found 5-7x the bound at G0/G_inf = 101 and 10 relaxed d_c.
+outside tester (0.10.0 round) found 5-7x the bound at G0/G_inf = 101 and 10 relaxed d_c.
 
 What: one adhesive sphere (R = 1 mm, G0 = 1 GPa, w = 0.01 J/m^2, one Kelvin element, or a
 K = 3 Prony chain) pressed from 0.5 d_c above the surface to D relaxed d_c (docs/concepts.md:

@@ -157,7 +157,7 @@ def test_the_resolved_numerics_meet_the_tolerance_against_the_independent_refere
 
 @pytest.mark.parametrize("tolerance", [1e-2, 3e-3])
 def test_a_large_glass_to_relaxed_ratio_gets_the_elements_its_tolerance_needs(tolerance: float) -> None:
-    """Round 10 (B1): the paper's material, G0 = 1 GPa, one Kelvin element G1 = 10 MPa
+    """0.10.0, an outside tester: the paper's material, G0 = 1 GPa, one Kelvin element G1 = 10 MPa
     (G0/G_inf = 101), retardation time 1 ms, w = 0.01 J/m^2, a 1 mm sphere pressed to 10 relaxed
     d_c in 5 ms and pulled to -3 d_c in 5 ms (1001 rows; a/R = 0.08, valid geometry). The
     model fitted at G0/G_inf <= 11 chose 192 (1e-2) and 384 (3e-3) elements for errors of 4.8e-2

@@ -11,7 +11,7 @@ against an independent reference": elastic, relaxed, partly relaxed, glassy and 
 sphere, cone and power-law indenters; slow and fast retraction; elastic and glassy bodies 5 and
 300 d_c deep, viscoelastic ones with G0/G_inf <= 11 at most 12 relaxed d_c deep, 100 when
 relaxed, cones and power laws 5). Force errors are relative to the pull-off force (never to the
-peak compressive force). A larger G0/G_inf or a deeper viscoelastic press exceeds them (round 10:
+peak compressive force). A larger G0/G_inf or a deeper viscoelastic press exceeds them (0.10.0:
 the paper's G0/G_inf = 101 at 10 relaxed d_c is 7.0e-2 at `balanced`; docs/configuration.md
 lists the measured exceptions):
 
@@ -263,7 +263,7 @@ ERROR_MODEL: dict[str, tuple[tuple[float, float], ...]] = {
     "viscoelastic": ((350.0, 2.0),),
     "viscoelastic, K >= 2": ((350.0, 2.0), (11.0, 1.3)),
 }
-#: The viscoelastic error grows with G0/G_inf (round 10: the paper's material, G0/G_inf = 101,
+#: The viscoelastic error grows with G0/G_inf (0.10.0: the paper's material, G0/G_inf = 101,
 #: 10 relaxed d_c deep, was 5x the model above). It is a discretisation error of the deepest
 #: rows: ~1-2.5 (L / (a N))^2 of the force there (a the contact radius, L the domain, which
 #: doubles when the contact reaches its end, so L/a is up to 2 right after a growth), i.e.
