@@ -2636,7 +2636,8 @@ def _advance_from(
     substeps = 0
     attempts = 0
     jumped_before = False
-    let_go = math.nan
+    # Written in the substep that lets go (no loop-carried variable in the substep loop).
+    out[OUT_LET_GO] = math.nan
     # Touch times planned this step (`_touch_time`), whether the substep being tried ends
     # just before a planned touch (then the jump substep follows) and whether it is the jump
     # substep that crosses one.
@@ -3043,7 +3044,7 @@ def _advance_from(
             motion = sub_motion
         jumped = abs(new_a - a) > max_edge_move
         if new_a <= 0.0 < a:
-            let_go = db
+            out[OUT_LET_GO] = db
         a = new_a
         tau += h
         substeps += 1
@@ -3140,7 +3141,6 @@ def _advance_from(
     # K = 0: no Kelvin element, no memory (wsum stays 0: every write of it is a sum over no
     # modes), so no O(N) scan for its peak (it was more than half of a K = 0 row at N = 4096).
     out[OUT_MEMORY] = peak if k_count else 0.0
-    out[OUT_LET_GO] = let_go
     _edge_outputs(a, d1, wsum, bsum, dx, g_c, gf, df, c_crit, out)
     return STATUS_OK
 
