@@ -22,6 +22,7 @@ from viscoadh_ros.core._kernels import (
     MOTION_NONE,
     OUT_DISSIPATED,
     OUT_FORCE,
+    OUT_LET_GO,
     OUT_MEMORY,
     OUT_MOTION,
     OUT_RADIUS,
@@ -125,6 +126,7 @@ def advance_from_reference(
     substeps = 0
     attempts = 0
     jumped_before = False
+    let_go = math.nan
     # Touch times planned this step (`_touch_time`), whether the substep being tried ends
     # just before a planned touch (then the jump substep follows) and whether it is the jump
     # substep that crosses one.
@@ -179,6 +181,7 @@ def advance_from_reference(
         out[OUT_SUBSTEPS] = 0
         out[OUT_DISSIPATED] = max(hysteresis, 0.0)
         out[OUT_MEMORY] = _memory_peak(wsum)
+        out[OUT_LET_GO] = d1 if new_a <= 0.0 < a else math.nan
         _edge_outputs(new_a, d1, wsum, bsum, dx, g_c, gf, df, c_crit, out)
         return STATUS_OK
     while tau < dt:
@@ -343,6 +346,8 @@ def advance_from_reference(
         if sub_motion != MOTION_NONE:
             motion = sub_motion
         jumped = abs(new_a - a) > max_edge_move
+        if new_a <= 0.0 < a:
+            let_go = db
         a = new_a
         tau += h
         substeps += 1
@@ -373,5 +378,6 @@ def advance_from_reference(
     out[OUT_SUBSTEPS] = substeps
     out[OUT_DISSIPATED] = lost
     out[OUT_MEMORY] = peak if k_count else _memory_peak(wsum)
+    out[OUT_LET_GO] = let_go
     _edge_outputs(a, d1, wsum, bsum, dx, g_c, gf, df, c_crit, out)
     return STATUS_OK

@@ -190,7 +190,8 @@ def random_rows() -> dict[str, np.ndarray]:
                     status, out = _kernels.advance(
                         row, a, d0, d1, dt, max_substep=0.0, max_edge_move=cells * row.dx
                     )
-                    outs.append([float(status), *out.tolist()])
+                    # The slots the file's kernel wrote (OUT_LET_GO is 0.10.0's, after them).
+                    outs.append([float(status), *out[: _kernels.OUT_LET_GO].tolist()])
                     mems.append(np.concatenate([row.wl.ravel(), row.wb.ravel()]))
                     if status != _kernels.STATUS_OK:
                         row.set_memory(memory, unit)

@@ -67,7 +67,10 @@ def reference_advance(self: Any, d0: float, d1: float, dt: float) -> tuple[float
         self.radius, self.dissipated = radius0, dissipated0
         self._grow(d0)
         start = self.get_state()
-    radius, force, work, _, substeps, dissipated, peak, outside, inside, g_edge = row.out.tolist()
+    # (The slots before OUT_LET_GO, 0.10.0's, which this reference does not read.)
+    radius, force, work, _, substeps, dissipated, peak, outside, inside, g_edge = row.out[
+        : _kernels.OUT_LET_GO
+    ].tolist()
     self.radius = radius
     self.substeps = int(substeps)
     self.dissipated += dissipated

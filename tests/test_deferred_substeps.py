@@ -137,7 +137,8 @@ def test_a_step_in_one_substep_is_bit_for_bit_the_old_loop() -> None:
         _, ref_out = advance_reference(ref, a, d_prev, d, 1e-4, max_substep=0.0, max_edge_move=ref.dx)
         if ref_out[_kernels.OUT_SUBSTEPS] == 1:
             singles += 1
-            assert np.array_equal(out, ref_out)
+            # (equal_nan: the let-go depth slot is NaN where the contact did not let go)
+            assert np.array_equal(out, ref_out, equal_nan=True)
             assert np.array_equal(row.wl, ref.wl) and np.array_equal(row.wb, ref.wb)
         a, d_prev = float(out[_kernels.OUT_RADIUS]), d
     assert singles >= 200

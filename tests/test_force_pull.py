@@ -181,3 +181,56 @@ def test_a_hard_pull_lets_go_where_a_gentle_one_does(make) -> None:
         # Bisected to half the tolerance of the held depth: within its whole tolerance.
         assert abs(out.depth - depth) <= tolerance * abs(held), (pull, out.depth, depth)
         assert back.contact_radius > 0.0 and abs(back.force - 0.02) <= 2.0 * tolerance * 0.02, (pull, back)
+
+
+class _Bisected(_Counting):
+    """The reference for the detachment search aimed by let-go depths (0.10.0): the model
+    says nothing of where a trial let go, so `_detachment` bisects (as before 0.10.0)."""
+
+    def _detachment(self, *args):
+        model = self._model
+        model.let_go_depth = None  # shadows the method: `_detachment` then bisects
+        try:
+            return super()._detachment(*args)
+        finally:
+            del model.let_go_depth
+
+
+def test_a_step_that_lets_go_says_where_along_its_path() -> None:
+    """The kernel's let-go depth (`_kernels.OUT_LET_GO`, `_TimeStepped.let_go_depth`): after
+    a step that let go it lies on the step's path (between the held depth and the depth
+    published, the trial's own); after one that held on, or never touched, NaN."""
+    make, commands = HISTORIES["bench_hold_pull"]
+    sim = ContactSimulator(make())
+    let_goes = 0
+    for kind, t, value in commands:
+        before = sim.output
+        out = apply(sim, kind, t, value)
+        jump = sim._model.let_go_depth()
+        if before.contact_radius > 0.0 and out.contact_radius == 0.0:
+            let_goes += 1
+            assert out.depth <= jump <= before.depth, (t, out.depth, jump, before.depth)
+        elif out.contact_radius > 0.0 or before.contact_radius == 0.0:
+            assert np.isnan(jump), (t, jump)
+    assert let_goes == 1
+
+
+@pytest.mark.parametrize("name", list(HISTORIES))
+def test_the_aimed_detachment_ends_where_the_bisection_ends(name: str) -> None:
+    """The detachment search aims its trials at the fold the let-go depths of the trials that
+    let go predict (`ContactSimulator._detachment`): every step ends where the bisection ends
+    (same contact state and flag, the force within the tolerance, the let-go depth within the
+    width both bisect to, and the steps after it as close), and the step that pulls off takes
+    fewer trials (bench: 36 -> 24; benchmarks/rounds/0.10.0-holdpull.md)."""
+    make, commands = HISTORIES[name]
+    sim, new, new_trials = _run(_Counting, make(), commands)
+    _, old, old_trials = _run(_Bisected, make(), commands)
+    tolerance = sim.numerics.force_tolerance
+    depth_scale = max(abs(o.depth) for o in old)
+    for index, (a, b) in enumerate(zip(new, old, strict=True)):
+        assert (a.contact_radius > 0.0) == (b.contact_radius > 0.0), (index, a, b)
+        assert a.unstable == b.unstable, (index, a, b)
+        assert abs(a.force - b.force) <= 2.0 * tolerance * max(abs(b.force), 1e-6 * 0.02), (index, a, b)
+        assert abs(a.depth - b.depth) <= 10.0 * tolerance * depth_scale, (index, a.depth, b.depth)
+    assert new_trials.max() < old_trials.max(), (new_trials.max(), old_trials.max())
+    assert new_trials.sum() < old_trials.sum()

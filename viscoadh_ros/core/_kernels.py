@@ -79,7 +79,12 @@ OUT_GAP_OUTSIDE = 7
 OUT_GAP_INSIDE = 8
 #: Profile g at the new edge, m (fine-grid interpolation, as the kernel sees it; 0 without contact).
 OUT_G_EDGE = 9
-OUT_SIZE = 10
+#: Depth at the end of the substep in which the contact last went from touching to none in
+#: this step (the fold at pull-off, located in time to JUMP_RESOLUTION of the step), m; NaN when
+#: it did not. A force search reads it from a trial that let go (`ContactSimulator._detachment`):
+#: where along its path the contact let go tells where the trial that just holds on ends.
+OUT_LET_GO = 10
+OUT_SIZE = 11
 
 #: Columns of `_advance_rows`'s per-row output: the `out` slots (gaps included).
 ROW_GAP_OUTSIDE = OUT_GAP_OUTSIDE
@@ -2652,6 +2657,8 @@ def _advance_from(
     substeps = 0
     attempts = 0
     jumped_before = False
+    # Written in the substep that lets go (no loop-carried variable in the substep loop).
+    out[OUT_LET_GO] = math.nan
     # Touch times planned this step (`_touch_time`), whether the substep being tried ends
     # just before a planned touch (then the jump substep follows) and whether it is the jump
     # substep that crosses one.
@@ -2706,6 +2713,7 @@ def _advance_from(
         out[OUT_SUBSTEPS] = 0
         out[OUT_DISSIPATED] = max(hysteresis, 0.0)
         out[OUT_MEMORY] = _memory_peak(wsum)
+        out[OUT_LET_GO] = d1 if new_a <= 0.0 < a else math.nan
         _edge_outputs(new_a, d1, wsum, bsum, dx, g_c, gf, df, c_crit, out)
         return STATUS_OK
     # Deferred elements (`_advance_from`'s docstring): [t_lo, t_hi) is the union of the trial
@@ -3056,6 +3064,8 @@ def _advance_from(
         if sub_motion != MOTION_NONE:
             motion = sub_motion
         jumped = abs(new_a - a) > max_edge_move
+        if new_a <= 0.0 < a:
+            out[OUT_LET_GO] = db
         a = new_a
         tau += h
         substeps += 1

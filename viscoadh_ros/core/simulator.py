@@ -850,6 +850,12 @@ class _TimeStepped:
         self._stepped(row, result, d1, dissipated0)
         return result[1], result[2], result[3]
 
+    def let_go_depth(self) -> float:
+        """Where the last kernel call's contact let go (`_kernels.OUT_LET_GO`), m; NaN when it
+        did not (or no call ran on the row)."""
+        row = self.row
+        return float(row.out[_kernels.OUT_LET_GO]) if row is not None else math.nan
+
     def _start_force(self, row: _kernels.Row, d0: float) -> float:
         """The force at the start of a step from depth `d0` (m) on `row`, N, when the last
         kernel call ended there (same row, radius and depth), else NaN: the kernel integrates
@@ -1265,6 +1271,22 @@ def _path_prediction(path: tuple, time: float, target: float, slope: float) -> f
         depth += weight * point[1]
         force += weight * point[2]
     return depth + (target - force) / slope
+
+
+def _fold_estimate(pairs: list[tuple[float, float]]) -> float:
+    """Where a pull's step lets go, m, from its trials that let go: `pairs` of (the trial's
+    depth, the depth along its path where it let go), m, in increasing trial depth (nearest
+    the fold last). The let-go depth moves with the trial's depth about linearly near the
+    fold (`ContactSimulator._detachment`): the fixed point of the line through the last two
+    when its slope is in (-1, 0.5), else the last let-go depth."""
+    x2, j2 = pairs[-1]
+    if len(pairs) > 1:
+        x1, j1 = pairs[-2]
+        if x1 < x2:
+            slope = (j2 - j1) / (x2 - x1)
+            if -1.0 < slope < 0.5:
+                return (j2 - slope * x2) / (1.0 - slope)
+    return j2
 
 
 def _lagrange_weights(times: list[float], time: float) -> tuple[float, ...] | None:
@@ -2555,13 +2577,14 @@ class ContactSimulator:
         The minimum is searched by golden section between the neighbours (by depth) of the
         smallest attached trial, a detached point counting as above everything, and given up
         once the smallest attached force found is above the target by more than the force can
-        drop within the bracket; only then is the detachment depth bisected, to 1e-13
-        relative, to half the force tolerance of the depths where the contact holds, or to
-        where the force cannot move by more than half the force tolerance of the largest
-        attached force across the interval (0.8.0: not of the target, which no attached
-        depth reaches, nor of the detached end's depth: a hard pull moved the published
-        depth). Both use the Lipschitz bound 2 x the glass stiffness 2 E0* a of the largest
-        contact tried (F(d) moves no faster under an instantaneous change of depth).
+        drop within the bracket; only then is the detachment depth bracketed (`_detachment`:
+        aimed trials, within ITP's projection of a bisection), to 1e-13 relative, to half the
+        force tolerance of the depths where the contact holds, or to where the force cannot
+        move by more than half the force tolerance of the largest attached force across the
+        interval (0.8.0: not of the target, which no attached depth reaches, nor of the
+        detached end's depth: a hard pull moved the published depth). Both use the Lipschitz
+        bound 2 x the glass stiffness 2 E0* a of the largest contact tried (F(d) moves no
+        faster under an instantaneous change of depth).
 
         `golden_section=False` skips the first part (a search before found no dip around
         the same minimum), `detachment=False` the second (returns (None, nan): the steps
@@ -2638,18 +2661,112 @@ class ContactSimulator:
             0.5 * tolerance * held / lipschitz if lipschitz > 0.0 else 0.0,
             0.5 * tolerance * max(abs(hi), abs(self._depth)),
         )
-        for _ in range(60):
-            if hi - lo <= max(1e-13 * max(abs(hi), abs(lo), 1e-300), width):
+        return self._detachment(residual, trials, target, lo, hi, width)
+
+    def _detachment(
+        self,
+        residual,
+        trials: list[tuple[float, float, float]],
+        target: float,
+        lo: float,
+        hi: float,
+        width: float,
+    ) -> tuple[tuple[float, float, float, float] | None, float]:
+        """The detachment between the detached depth `lo` and the attached depth `hi` (m)
+        (`_search_dip`'s second part): a bracket no wider than `width` (m), its detached end
+        returned as (None, end); or ((lo, r_lo, hi, r_hi), nan) when a trial on the way holds
+        at or below the target.
+
+        A trial that lets go says where along its path it did (`_TimeStepped.let_go_depth`),
+        and near the fold that depth moves with the trial's depth about linearly: on the
+        bench's hold-and-pull pull-off the let-go depth d_j of a trial to depth d is d_c +
+        k (d - d_c), d_c the fold, k from -0.04 (d 2.6e-2 of the depth below d_c) to -0.09
+        (4e-5 below), other histories k -0.3 .. 0, down to the trials that let go in the
+        step's last substep (the jump is located to JUMP_RESOLUTION of the step: there d_j =
+        d). So each trial aims a `spread` short of the fold estimated from the trials that
+        let go (`_fold_estimate`), on the side with more room: below it (the trial lets go,
+        and gives a let-go depth nearer the fold) or above it (it holds: the attached end
+        comes down). The spread is the larger of 0.45 of the width, FOLD_JUMP of the jump's
+        resolution in depth, and FOLD_MARGIN (FOLD_MARGIN_ONE while one trial let go: its
+        estimate takes k = 0) of the estimate's distance from the nearest trial that let go,
+        times a factor that a trial landing on the side not aimed at multiplies by FOLD_MISS
+        and one landing as aimed by FOLD_HIT (down to 1). ITP's projection keeps every trial
+        within `radius` of the midpoint, so the search takes at most FOLD_EXTRA trials more
+        than the bisection whatever the estimates; without let-go depths (the closed forms,
+        no trial let go from a contact) it is the bisection. The estimate only places the
+        trials: the bracket, its width and the end returned are the bisection's."""
+        let_go = getattr(self._model, "let_go_depth", None)
+        pairs: list[tuple[float, float]] = []  # (depth, let-go depth) of the trials that let go
+        if let_go is not None and trials and trials[-1][0] == lo:
+            # `lo` is the last trial: the model is still in its state.
+            jump = let_go()
+            if lo < jump:
+                pairs.append((lo, jump))
+        d0 = self._depth
+        limit = max(1e-13 * max(abs(hi), abs(lo), 1e-300), width)
+        most = max(math.ceil(math.log2(max((hi - lo) / limit, 1.0))), 0) + self.FOLD_EXTRA
+        factor = 1.0
+        for k in range(1, 121):
+            limit = max(1e-13 * max(abs(hi), abs(lo), 1e-300), width)
+            gap = hi - lo
+            if gap <= limit:
                 break
             mid = 0.5 * (lo + hi)
-            r_mid = residual(mid)
-            if not self._attached():
-                lo = mid
+            x = mid
+            aim = 0  # -1: aimed to let go, 1: to hold
+            if pairs:
+                fold = _fold_estimate(pairs)
+                nearest = pairs[-1][0]
+                margin = self.FOLD_MARGIN if len(pairs) > 1 else self.FOLD_MARGIN_ONE
+                spread = factor * max(
+                    0.45 * limit,
+                    self.FOLD_JUMP * _kernels.JUMP_RESOLUTION * abs(nearest - d0),
+                    margin * abs(fold - nearest),
+                )
+                below = lo < fold - spread
+                above = fold + spread < hi
+                if below and (not above or fold - lo >= hi - fold):
+                    x, aim = fold - spread, -1
+                elif above:
+                    x, aim = fold + spread, 1
+                # ITP's projection: within `radius` of the midpoint the bracket after trial
+                # k is at most limit 2^(most - k) wide.
+                radius = max(limit * 2.0 ** (most - k) - 0.5 * gap, 0.0)
+                if not lo < x < hi:
+                    x, aim = mid, 0
+                elif not abs(x - mid) <= radius:
+                    x, aim = mid + math.copysign(radius, x - mid), 0
+            r_x = residual(x)
+            attached = self._attached()
+            if attached:
+                hi = x
+                if r_x <= 0.0:
+                    return self._dip_bracket(trials, target, x, r_x), math.nan
             else:
-                hi = mid
-                if r_mid <= 0.0:
-                    return self._dip_bracket(trials, target, mid, r_mid), math.nan
+                lo = x
+                if let_go is not None:
+                    jump = let_go()
+                    if x < jump:
+                        pairs.append((x, jump))
+            if aim:
+                missed = (aim > 0) != attached
+                factor = factor * self.FOLD_MISS if missed else max(1.0, factor * self.FOLD_HIT)
         return None, lo
+
+    #: `_detachment`: trials it may take over the bisection's count; the spread of an aimed
+    #: trial as a fraction of the fold estimate's distance from the nearest trial that let go
+    #: (from two such trials or more, and from one); the spread's factor after a trial that
+    #: landed on the side not aimed at, and after one that landed as aimed; the spread's
+    #: floor as a fraction of the let-go depth's resolution (JUMP_RESOLUTION of the trial's
+    #: path: the fits came within a fraction of it; 1 cost 1-5 trials more). Chosen on the
+    #: bench's and the tests' hold-and-pull histories, checked on 16 others (pull rates,
+    #: time steps, K = 0/1/2): benchmarks/rounds/0.10.0-holdpull.md.
+    FOLD_EXTRA = 2
+    FOLD_MARGIN = 0.03
+    FOLD_MARGIN_ONE = 0.5
+    FOLD_MISS = 2.0
+    FOLD_HIT = 0.5
+    FOLD_JUMP = 0.2
 
     @staticmethod
     def _dip_bracket(
