@@ -1100,6 +1100,115 @@ def _four_lanes(typingctx, values, magnitudes, start, groups, peak):
     return signature, codegen
 
 
+def _group_loop(free):
+    """The intrinsic that updates ``groups`` groups of four K = 1 elements from ``start`` as
+    4-wide vectors and sums their losses and |wsum| into the lanes of `_sum_losses` (given and
+    returned as ``(s0, s1, s2, s3, p0, p1, p2, p3)``), for `_update_range_one` (0.10.0):
+    in contact (``free`` False; ``c`` = d0, d1, p00, q00, lam0, beta0, e_0, phi1_0, chi_0,
+    cee_0, cef_0, 2 b, b b cff_0, beta0 phi1_0, 2 dx) or out of it (``c`` = decay_0, ek_0, dx).
+    Each vector operation is the scalar loop's, in its order (IEEE operations lane by lane:
+    the same bits), with ``diss`` written if ``store``. Numba runs LLVM without its SLP
+    vectoriser and the loop vectoriser may not reorder a float sum, so a loop that sums as
+    it goes stays scalar: written as vectors, the lanes' sums ride on the update instead of
+    a second pass over ``diss`` and ``wsum`` whose chain of additions is its whole cost."""
+    array = types.Array(types.float64, 1, "C")
+    lanes_type = types.UniTuple(types.float64, 8)
+
+    def typer(typingctx, w, u, wsum, bsum, diss, g_c, start, groups, c, lanes, store):
+        for value in (w, u, wsum, bsum, diss, g_c):
+            if value != array:
+                return None
+        if not isinstance(c, types.UniTuple) or c.dtype != types.float64 or c.count != (3 if free else 15):
+            return None
+        return lanes_type(w, u, wsum, bsum, diss, g_c, types.intp, types.intp, c, lanes_type, types.boolean), _codegen
+
+    def _codegen(context, builder, sig, args):
+        data = [context.make_array(sig.args[j])(context, builder, value=args[j]).data for j in range(6)]
+        w, u, wsum, bsum, diss, g_c = data
+        first, count, constants, initial, store = args[6:]
+        f64 = llvm_ir.DoubleType()
+        v4 = llvm_ir.VectorType(f64, 4)
+        i32 = llvm_ir.IntType(32)
+        fabs = cgutils.get_or_insert_function(builder.module, llvm_ir.FunctionType(v4, [v4]), "llvm.fabs.v4f64")
+
+        def splat(value):
+            vector = llvm_ir.Constant(v4, llvm_ir.Undefined)
+            for lane in range(4):
+                vector = builder.insert_element(vector, value, llvm_ir.Constant(i32, lane))
+            return vector
+
+        c = [splat(builder.extract_value(constants, j)) for j in range(sig.args[8].count)]
+        zero = llvm_ir.Constant(v4, [0.0, 0.0, 0.0, 0.0])
+        start_sums = llvm_ir.Constant(v4, llvm_ir.Undefined)
+        start_peaks = llvm_ir.Constant(v4, llvm_ir.Undefined)
+        for lane in range(4):
+            index = llvm_ir.Constant(i32, lane)
+            start_sums = builder.insert_element(start_sums, builder.extract_value(initial, lane), index)
+            start_peaks = builder.insert_element(start_peaks, builder.extract_value(initial, 4 + lane), index)
+        sums = cgutils.alloca_once_value(builder, start_sums)
+        peaks = cgutils.alloca_once_value(builder, start_peaks)
+        four = llvm_ir.Constant(first.type, 4)
+        add, sub, mul = builder.fadd, builder.fsub, builder.fmul
+        with cgutils.for_range(builder, count) as loop:
+            at = builder.add(first, builder.mul(loop.index, four))
+
+            def load(pointer):
+                return builder.load(cgutils.gep(builder, pointer, at), align=8, typ=v4)
+
+            def store_to(pointer, value):
+                address = builder.bitcast(cgutils.gep(builder, pointer, at), v4.as_pointer())
+                builder.store(value, address, align=8)
+
+            if free:
+                decay_0, ek_0, dx = c
+                before = load(w)
+                after = mul(before, decay_0)
+                after_b = mul(load(u), decay_0)
+                store_to(w, after)
+                store_to(u, after_b)
+                total = add(zero, after)
+                store_to(wsum, total)
+                store_to(bsum, add(zero, after_b))
+                loss = mul(dx, add(zero, mul(ek_0, sub(mul(before, before), mul(after, after)))))
+            else:
+                d0, d1, p00, q00, lam0, beta0, e_0, phi1_0, chi_0, cee_0, cef_0, b2, bb_cff, beta_phi, two_dx = c
+                g = load(g_c)
+                u0 = sub(d0, g)
+                u1 = sub(d1, g)
+                acc = mul(p00, load(w))
+                acc_b = mul(p00, load(u))
+                z0 = add(mul(e_0, acc), mul(beta0, add(mul(u0, phi1_0), mul(sub(u1, u0), chi_0))))
+                zb0 = add(mul(e_0, acc_b), beta_phi)
+                zeta0 = sub(mul(beta0, u0), mul(lam0, acc))
+                q = add(add(mul(mul(zeta0, zeta0), cee_0), mul(mul(zeta0, b2), cef_0)), bb_cff)
+                work = builder.select(builder.fcmp_ordered(">", q, zero), q, zero)
+                new = add(zero, mul(q00, z0))
+                new_b = add(zero, mul(q00, zb0))
+                store_to(w, new)
+                store_to(u, new_b)
+                total = add(zero, new)
+                store_to(wsum, total)
+                store_to(bsum, add(zero, new_b))
+                loss = mul(two_dx, work)
+            with builder.if_then(store):
+                store_to(diss, loss)
+            builder.store(add(builder.load(sums), loss), sums)
+            magnitude = builder.call(fabs, [total])
+            top = builder.load(peaks)
+            builder.store(builder.select(builder.fcmp_ordered(">", magnitude, top), magnitude, top), peaks)
+        total_sums = builder.load(sums)
+        total_peaks = builder.load(peaks)
+        lanes = [builder.extract_element(total_sums, llvm_ir.Constant(i32, r)) for r in range(4)]
+        lanes += [builder.extract_element(total_peaks, llvm_ir.Constant(i32, r)) for r in range(4)]
+        return context.make_tuple(builder, sig.return_type, lanes)
+
+    return intrinsic(typer)
+
+
+_groups_in = _group_loop(False)
+_groups_free = _group_loop(True)
+
+
 @numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
 def _sum_losses(diss, wsum, lo, hi, total, peak):
     """``(total + sum(diss[lo:hi]), max(peak, max |wsum[lo:hi]|))`` in four interleaved lanes
@@ -1119,6 +1228,44 @@ def _sum_losses(diss, wsum, lo, hi, total, peak):
         p0 = max(p0, abs(wsum[i]))
         i += one
     return total + ((s0 + s1) + (s2 + s3)), max(max(p0, p1), max(p2, p3))
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
+def _one_element(w, u, wsum, bsum, diss, g_c, i, mid, c_in, c_free):
+    """Element i of `_update_range_one` alone (in contact if i < mid; ``c_in``, ``c_free`` as
+    `_group_loop`'s ``c``): the vector loops' operations on one element. Returns its loss, J,
+    and the |wsum| it leaves, m."""
+    if i < mid:
+        d0, d1, p00, q00, lam0, beta0, e_0, phi1_0, chi_0, cee_0, cef_0, b2, bb_cff, beta_phi, two_dx = c_in
+        u0 = d0 - g_c[i]
+        u1 = d1 - g_c[i]
+        acc = p00 * w[i]
+        acc_b = p00 * u[i]
+        z0 = e_0 * acc + beta0 * (u0 * phi1_0 + (u1 - u0) * chi_0)
+        zb0 = e_0 * acc_b + beta_phi
+        zeta0 = beta0 * u0 - lam0 * acc
+        q = zeta0 * zeta0 * cee_0 + zeta0 * b2 * cef_0 + bb_cff
+        work = q if q > 0.0 else 0.0
+        new = 0.0 + q00 * z0
+        new_b = 0.0 + q00 * zb0
+        w[i] = new
+        u[i] = new_b
+        total = 0.0 + new
+        wsum[i] = total
+        bsum[i] = 0.0 + new_b
+        loss = two_dx * work
+    else:
+        decay_0, ek_0, dx = c_free
+        before = w[i]
+        after = before * decay_0
+        w[i] = after
+        u[i] = u[i] * decay_0
+        total = 0.0 + after
+        wsum[i] = total
+        bsum[i] = 0.0 + u[i]
+        loss = dx * (0.0 + ek_0 * (before * before - after * after))
+    diss[i] = loss
+    return loss, abs(total)
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
@@ -1144,6 +1291,7 @@ def _update_range_one(
     dx,
     total,
     peak,
+    store,
 ):
     """`_update_range` for one Kelvin element (K = 1), written so the compiler vectorises it:
     flat arrays, the element loops free of the running sums (taken after, `_sum_losses`).
@@ -1176,33 +1324,40 @@ def _update_range_one(
     b = beta0 * slope
     b2 = 2.0 * b
     bb_cff = b * b * cff_0
+    c_in = (d0, d1, p00, q00, lam0, beta0, e_0, phi1_0, chi_0, cee_0, cef_0, b2, bb_cff, beta0 * phi1_0, 2.0 * dx)
+    c_free = (decay_0, ek_0, dx)
+    lanes = (0.0, 0.0, 0.0, 0.0, peak, peak, peak, peak)
     mid = max(min(hi, n_in), lo)
-    for i in range(_u(lo), _u(mid)):
-        u0 = d0 - g_c[i]
-        u1 = d1 - g_c[i]
-        acc = p00 * w[i]
-        acc_b = p00 * u[i]
-        z0 = e_0 * acc + beta0 * (u0 * phi1_0 + (u1 - u0) * chi_0)
-        zb0 = e_0 * acc_b + beta0 * phi1_0
-        zeta0 = beta0 * u0 - lam0 * acc
-        q = zeta0 * zeta0 * cee_0 + zeta0 * b2 * cef_0 + bb_cff
-        work = q if q > 0.0 else 0.0
-        new = 0.0 + q00 * z0
-        new_b = 0.0 + q00 * zb0
-        w[i] = new
-        u[i] = new_b
-        wsum[i] = 0.0 + new
-        bsum[i] = 0.0 + new_b
-        diss[i] = 2.0 * dx * work
-    for i in range(_u(mid), _u(hi)):
-        before = w[i]
-        after = before * decay_0
-        w[i] = after
-        u[i] = u[i] * decay_0
-        wsum[i] = 0.0 + after
-        bsum[i] = 0.0 + u[i]
-        diss[i] = dx * (0.0 + ek_0 * (before * before - after * after))
-    return _sum_losses(diss, wsum, lo, hi, total, peak)
+    # Whole groups of four in contact, the group the edge splits (element by element), whole
+    # groups out of contact, the rest (element by element, lane 0): `_sum_losses`'s lanes.
+    start = lo
+    groups = (mid - lo) // 4
+    lanes = _groups_in(w, u, wsum, bsum, diss, g_c, start, groups, c_in, lanes, store)
+    start += 4 * groups
+    s0, s1, s2, s3, p0, p1, p2, p3 = lanes
+    if start < mid and start + 4 <= hi:
+        loss, top = _one_element(w, u, wsum, bsum, diss, g_c, start, mid, c_in, c_free)
+        s0 += loss
+        p0 = max(p0, top)
+        loss, top = _one_element(w, u, wsum, bsum, diss, g_c, start + 1, mid, c_in, c_free)
+        s1 += loss
+        p1 = max(p1, top)
+        loss, top = _one_element(w, u, wsum, bsum, diss, g_c, start + 2, mid, c_in, c_free)
+        s2 += loss
+        p2 = max(p2, top)
+        loss, top = _one_element(w, u, wsum, bsum, diss, g_c, start + 3, mid, c_in, c_free)
+        s3 += loss
+        p3 = max(p3, top)
+        start += 4
+    groups = max(hi - start, 0) // 4
+    lanes = _groups_free(w, u, wsum, bsum, diss, g_c, start, groups, c_free, (s0, s1, s2, s3, p0, p1, p2, p3), store)
+    start += 4 * groups
+    s0, s1, s2, s3, p0, p1, p2, p3 = lanes
+    for i in range(start, hi):
+        loss, top = _one_element(w, u, wsum, bsum, diss, g_c, i, mid, c_in, c_free)
+        s0 += loss
+        p0 = max(p0, top)
+    return total + ((s0 + s1) + (s2 + s3)), max(max(p0, p1), max(p2, p3))
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
@@ -1228,16 +1383,19 @@ def _update_range(
     dx,
     total,
     peak,
+    store=True,
 ):
     """`_kelvin_update` of elements lo..hi-1 with the coefficients in ``coef`` (one substep,
     `_substep_coefficients`); returns ``(total, peak)``: ``total`` plus the energy they
     dissipated, J (K <= 4: in four lanes, `_sum_losses`; K > 4: element by element in index
-    order), and the larger of ``peak`` and their largest |wsum|, m."""
+    order), and the larger of ``peak`` and their largest |wsum|, m. ``diss[i]`` gets element
+    i's loss; with ``store`` False it may not (K = 1 leaves it out: `_advance_from` reads
+    ``diss`` per element only over a substep's trial window, 0.10.0)."""
     k_count = wl.shape[1]
     args = (wl, wsum, wb, bsum, diss, lo, hi, n_in, d0, d1, slope, g_c, p, p_inv, lam, beta, coef)
     args = (*args, e_kelvin, dx)
     if k_count == 1:
-        return _update_range_one(*args, total, peak)
+        return _update_range_one(*args, total, peak, store)
     if k_count < 2 or k_count > 4:
         return _update_range_k(*args, total, peak, k_count)
     # K = 2, 3, 4: the element loops written out per K (generated, `_update_in_4`...): the modes
@@ -2919,6 +3077,7 @@ def _advance_from(
                 dx,
                 0.0,
                 0.0,
+                False,
             )
         hysteresis = _retime_crossed(
             wl,
@@ -2974,6 +3133,7 @@ def _advance_from(
                 dx,
                 viscous,
                 peak,
+                False,
             )
             if last and not whole and (t_lo > 0 or t_hi < n):
                 # The deferred elements in one update over the whole step (exact for a depth
@@ -3001,6 +3161,7 @@ def _advance_from(
                     dx,
                     viscous,
                     peak,
+                    False,
                 )
                 viscous, peak = _update_range(
                     wl,
@@ -3024,6 +3185,7 @@ def _advance_from(
                     dx,
                     viscous,
                     peak,
+                    False,
                 )
             if last:
                 t_lo = 0
@@ -3114,6 +3276,7 @@ def _advance_from(
                 dx,
                 viscous,
                 0.0,
+                False,
             )
             viscous, _ = _update_range(
                 wl,
@@ -3137,6 +3300,7 @@ def _advance_from(
                 dx,
                 viscous,
                 0.0,
+                False,
             )
             lost += viscous
             t_lo = 0
