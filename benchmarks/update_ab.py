@@ -1,8 +1,8 @@
 """Side-by-side A/B of the Kelvin update alone (`_update_range` over a whole row, 60 % of it in
-contact, 400 substeps of 1 ms on a synthetic row), several checkouts' kernel modules in ONE
+contact (``in=``), 400 substeps of 1 ms on a synthetic row), several checkouts' kernel modules in ONE
 process (issue 13, 0.10.0 `k1upd`):
 
-    .venv/bin/python benchmarks/update_ab.py ROOT [ROOT ...] [nk=N,K ...]
+    .venv/bin/python benchmarks/update_ab.py ROOT [ROOT ...] [nk=N,K ...] [in=FRACTION]
 
 The first ROOT is the reference; each other one's state (wl, wsum, wb, bsum) must equal it bit for
 bit, and its losses' sum and peak are compared. Prints us per update and ns per element, median
@@ -19,7 +19,8 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from ab_cores import renamed_kernels  # noqa: E402
 
-roots = [a for a in sys.argv[1:] if not a.startswith("nk=")]
+roots = [a for a in sys.argv[1:] if not a.startswith(("nk=", "in="))]
+fraction = float(next((a[3:] for a in sys.argv[1:] if a.startswith("in=")), "0.6"))
 cases = [tuple(int(x) for x in a[3:].split(",")) for a in sys.argv[1:] if a.startswith("nk=")] or [(512,1),(1024,1),(4096,1),(256,4),(1024,4)]
 mods = [renamed_kernels(r) for r in roots]
 
@@ -50,7 +51,7 @@ for n, k in cases:
     wl0 = 1e-7 * rng.random((n, k)); wb0 = 0.5 * rng.random((n, k))
     steps = 400
     depth = 1e-6 * (1.0 + 0.3 * np.sin(np.arange(steps + 1) * 0.01))
-    n_in = int(n * 0.6)
+    n_in = int(n * fraction)
     states = []
     for mod, loop in zip(mods, loops):
         coef = mod.coefficient_workspace(k)
