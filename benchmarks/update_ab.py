@@ -5,7 +5,8 @@ process (issue 13, 0.10.0 `k1upd`):
     .venv/bin/python benchmarks/update_ab.py ROOT [ROOT ...] [nk=N,K ...] [in=FRACTION]
 
 The first ROOT is the reference; each other one's state (wl, wsum, wb, bsum) must equal it bit for
-bit, and its losses' sum and peak are compared. Prints us per update and ns per element, median
+bit, and its losses' sum and peak are compared; at K = 1 a module whose rows alias wsum and bsum
+to wl and wb (`_state_layout`, 0.10.0) gets them so. Prints us per update and ns per element, median
 thread CPU time of interleaved repeats.
 """
 
@@ -57,6 +58,9 @@ for n, k in cases:
         coef = mod.coefficient_workspace(k)
         mod._substep_coefficients(lam, rate, 1e-3, coef)
         st = [wl0.copy(), wl0.sum(1), wb0.copy(), wb0.sum(1), np.zeros(n)]
+        if k == 1 and "wsum" not in dict(mod._state_layout(n, k)):
+            # As in the module's own rows: wsum and bsum are wl and wb (0.10.0).
+            st[1], st[3] = st[0].reshape(n), st[2].reshape(n)
         states.append((st, coef))
     def run(j):
         mod, loop = mods[j], loops[j]
