@@ -20,27 +20,34 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from ab_cores import renamed_kernels  # noqa: E402
 
-roots = [a for a in sys.argv[1:] if not a.startswith(("nk=", "in="))]
-fraction = float(next((a[3:] for a in sys.argv[1:] if a.startswith("in=")), "0.6"))
-cases = [tuple(int(x) for x in a[3:].split(",")) for a in sys.argv[1:] if a.startswith("nk=")] or [(512,1),(1024,1),(4096,1),(256,4),(1024,4)]
-mods = [renamed_kernels(r) for r in roots]
+STEPS = 400
+DT = 1e-3
 
-def make(mod):
-    upd = mod._update_range
+
+def _loop(module):
+    """`module`'s `_update_range` over every element of the row per step, compiled."""
+    update = module._update_range
+
     @numba.njit
-    def loop(wl, wsum, wb, bsum, diss, n_in, depth, dt, g_c, p, p_inv, lam, beta, coef, ek, dx):
+    def loop(state, n_in, depth, g_c, p, p_inv, lam, beta, coef, ek, dx):  # pragma: no cover
+        wl, wsum, wb, bsum, diss = state
         n = wl.shape[0]
-        tot = 0.0; pk = 0.0
+        total = 0.0
+        peak = 0.0
         for s in range(1, depth.shape[0]):
-            t, q = upd(wl, wsum, wb, bsum, diss, 0, n, n_in, depth[s-1], depth[s], (depth[s]-depth[s-1])/dt,
-                       g_c, p, p_inv, lam, beta, coef, ek, dx, 0.0, 0.0)
-            tot += t; pk = max(pk, q)
-        return tot, pk
+            slope = (depth[s] - depth[s - 1]) / DT
+            lost, top = update(
+                wl, wsum, wb, bsum, diss, 0, n, n_in, depth[s - 1], depth[s], slope,
+                g_c, p, p_inv, lam, beta, coef, ek, dx, 0.0, 0.0,
+            )  # fmt: skip
+            total += lost
+            peak = max(peak, top)
+        return total, peak
+
     return loop
 
-loops = [make(m) for m in mods]
-rng = np.random.default_rng(1)
-for n, k in cases:
+
+def _case(roots, modules, loops, n, k, fraction, rng):
     dx = 1e-6
     g_c = ((np.arange(n) + 0.5) * dx) ** 2 / 2e-3
     lam = np.logspace(1, 3, k) if k > 1 else np.array([100.0])
@@ -49,32 +56,63 @@ for n, k in cases:
     p_inv = np.linalg.inv(p)
     rate = lam * 0.7
     ek = np.linspace(1e6, 2e6, k)
-    wl0 = 1e-7 * rng.random((n, k)); wb0 = 0.5 * rng.random((n, k))
-    steps = 400
-    depth = 1e-6 * (1.0 + 0.3 * np.sin(np.arange(steps + 1) * 0.01))
+    wl0 = 1e-7 * rng.random((n, k))
+    wb0 = 0.5 * rng.random((n, k))
+    depth = 1e-6 * (1.0 + 0.3 * np.sin(np.arange(STEPS + 1) * 0.01))
     n_in = int(n * fraction)
     states = []
-    for mod, loop in zip(mods, loops):
-        coef = mod.coefficient_workspace(k)
-        mod._substep_coefficients(lam, rate, 1e-3, coef)
-        st = [wl0.copy(), wl0.sum(1), wb0.copy(), wb0.sum(1), np.zeros(n)]
-        if k == 1 and "wsum" not in dict(mod._state_layout(n, k)):
+    for module in modules:
+        coef = module.coefficient_workspace(k)
+        module._substep_coefficients(lam, rate, DT, coef)
+        state = [wl0.copy(), wl0.sum(1), wb0.copy(), wb0.sum(1), np.zeros(n)]
+        if k == 1 and "wsum" not in dict(module._state_layout(n, k)):
             # As in the module's own rows: wsum and bsum are wl and wb (0.10.0).
-            st[1], st[3] = st[0].reshape(n), st[2].reshape(n)
-        states.append((st, coef))
+            state[1], state[3] = state[0].reshape(n), state[2].reshape(n)
+        states.append((tuple(state), coef))
+
     def run(j):
-        mod, loop = mods[j], loops[j]
-        st, coef = states[j]
-        st[0][:] = wl0; st[2][:] = wb0
-        return loop(st[0], st[1], st[2], st[3], st[4], n_in, depth, 1e-3, g_c, p, p_inv, lam, beta, coef, ek, dx)
-    res = [run(j) for j in range(len(mods))]
-    for j in range(1, len(mods)):
-        st0, st = states[0][0], states[j][0]
-        same = all(np.array_equal(a.view(np.int64), b.view(np.int64)) for a, b in zip(st0[:4], st[:4]))
-        print(f"  [{j}] state equal {same}, total {res[j][0]==res[0][0]} ({(res[j][0]-res[0][0])/res[0][0]:.2e}), peak {res[j][1]==res[0][1]}")
-    samples = [[] for _ in mods]
-    for r in range(int(9 if n <= 1024 else 5) * 3):
-        for j in range(len(mods)):
-            t0 = time.thread_time(); run(j); samples[j].append(time.thread_time() - t0)
-    med = [np.median(s) / steps * 1e6 for s in samples]
-    print(f"N={n} K={k}: " + "  ".join(f"{roots[j].split('/')[-1]} {med[j]:.3f} us ({med[j]/n*1e3:.2f} ns/el)" for j in range(len(mods))) + f"  B/A {med[-1]/med[0]:.3f}")
+        state, coef = states[j]
+        state[0][...] = wl0
+        state[2][...] = wb0
+        return loops[j](state, n_in, depth, g_c, p, p_inv, lam, beta, coef, ek, dx)
+
+    results = [run(j) for j in range(len(modules))]
+    for j in range(1, len(modules)):
+        same = all(
+            np.array_equal(a.view(np.int64), b.view(np.int64))
+            for a, b in zip(states[0][0][:4], states[j][0][:4], strict=True)
+        )
+        (total0, peak0), (total, peak) = results[0], results[j]
+        print(
+            f"  [{j}] state equal {same}, total {total == total0} ({(total - total0) / total0:.2e}), "
+            f"peak {peak == peak0}"
+        )
+    samples = [[] for _ in modules]
+    for _ in range((9 if n <= 1024 else 5) * 3):
+        for j in range(len(modules)):
+            start = time.thread_time()
+            run(j)
+            samples[j].append(time.thread_time() - start)
+    us = [np.median(values) / STEPS * 1e6 for values in samples]
+    cells = "  ".join(
+        f"{root.rstrip('/').split('/')[-1]} {value:.3f} us ({value / n * 1e3:.2f} ns/el)"
+        for root, value in zip(roots, us, strict=True)
+    )
+    print(f"N={n} K={k}: {cells}  B/A {us[-1] / us[0]:.3f}")
+
+
+def main() -> None:
+    argv = sys.argv[1:]
+    roots = [a for a in argv if not a.startswith(("nk=", "in="))]
+    fraction = float(next((a[3:] for a in argv if a.startswith("in=")), "0.6"))
+    cases = [tuple(int(x) for x in a[3:].split(",")) for a in argv if a.startswith("nk=")]
+    cases = cases or [(512, 1), (1024, 1), (4096, 1), (256, 4), (1024, 4)]
+    modules = [renamed_kernels(root) for root in roots]
+    loops = [_loop(module) for module in modules]
+    rng = np.random.default_rng(1)
+    for n, k in cases:
+        _case(roots, modules, loops, n, k, fraction, rng)
+
+
+if __name__ == "__main__":
+    main()

@@ -43,7 +43,6 @@ def test_the_losses_and_the_peak_in_four_lanes(seed: int) -> None:
         assert abs(want_total - exact) <= 2.0 * (hi - lo + 2) * EPS * exact
 
 
-
 def _scalar_lanes(diss, wsum, lo, hi, total, peak):
     """The 0.7.0 `_sum_losses`: four scalar lanes (element lo + 4 j + r in lane r, the rest in
     lane 0), as the vector lanes of `_kernels._four_lanes` (0.10.0) must give them."""
@@ -59,7 +58,9 @@ def _scalar_lanes(diss, wsum, lo, hi, total, peak):
         sums[0] += diss[i]
         peaks[0] = max(peaks[0], abs(wsum[i]))
         i += 1
-    return total + ((sums[0] + sums[1]) + (sums[2] + sums[3])), max(max(peaks[0], peaks[1]), max(peaks[2], peaks[3]))
+    return total + ((sums[0] + sums[1]) + (sums[2] + sums[3])), max(
+        max(peaks[0], peaks[1]), max(peaks[2], peaks[3])
+    )
 
 
 @pytest.mark.parametrize("seed", range(3))
@@ -77,6 +78,7 @@ def test_the_vector_lanes_are_the_scalar_lanes_bit_for_bit(seed: int) -> None:
         got = _kernels._sum_losses(diss, wsum, lo, hi, total0, peak0)
         want = _scalar_lanes(diss, wsum, lo, hi, total0, peak0)
         assert np.array(got).tobytes() == np.array(want).tobytes(), (lo, hi, got, want)
+
 
 def test_an_elastic_row_keeps_no_memory_so_its_peak_is_not_scanned() -> None:
     """K = 0 (no Kelvin element): `_advance_from` reports the memory peak as 0 without the O(N)

@@ -18,7 +18,8 @@ points it is linear. The contact radius ``a`` is continuous: elements with ``x_i
 are in contact ("interior"; at least element 0 when ``a > 0``), the others are exterior.
 
 State. ``wl[i, k]`` is the elongation of Kelvin element k of element i, m; ``wsum[i]``
-their sum (at K = 1 in a row's buffer the same memory as ``wl``, `_state_layout`). Interior glass elongation ``l0 = d - g(x) - wsum``, exterior ``l0 = 0``.
+their sum (at K = 1 in a row's buffer the same memory as ``wl``, `_state_layout`). Interior
+glass elongation ``l0 = d - g(x) - wsum``, exterior ``l0 = 0``.
 The chain is linear in its input ``u_i(t) = d(t) - g(x_i)``, so its state splits exactly
 as ``wl_i = A_i - g(x_i) B_i``: ``A`` is the chain's response to ``d(t)`` and ``B``
 (``wb[i, k]``, sum ``bsum[i]``, dimensionless) its response to a unit input over the same
@@ -1076,7 +1077,9 @@ def _four_lanes(typingctx, values, magnitudes, start, groups, peak):
         first, count, peak_value = args[2], args[3], args[4]
         f64 = llvm_ir.DoubleType()
         v4 = llvm_ir.VectorType(f64, 4)
-        fabs = cgutils.get_or_insert_function(builder.module, llvm_ir.FunctionType(v4, [v4]), "llvm.fabs.v4f64")
+        fabs = cgutils.get_or_insert_function(
+            builder.module, llvm_ir.FunctionType(v4, [v4]), "llvm.fabs.v4f64"
+        )
         spread = llvm_ir.Constant(v4, llvm_ir.Undefined)
         for lane in range(4):
             spread = builder.insert_element(spread, peak_value, llvm_ir.Constant(llvm_ir.IntType(32), lane))
@@ -1090,7 +1093,9 @@ def _four_lanes(typingctx, values, magnitudes, start, groups, peak):
             builder.store(builder.fadd(builder.load(sums), lane_values), sums)
             magnitude = builder.call(fabs, [lane_magnitudes])
             before = builder.load(peaks)
-            builder.store(builder.select(builder.fcmp_ordered(">", magnitude, before), magnitude, before), peaks)
+            builder.store(
+                builder.select(builder.fcmp_ordered(">", magnitude, before), magnitude, before), peaks
+            )
         total = builder.load(sums)
         top = builder.load(peaks)
         lanes = [builder.extract_element(total, llvm_ir.Constant(llvm_ir.IntType(32), r)) for r in range(4)]
@@ -1120,7 +1125,9 @@ def _group_loop(free):
                 return None
         if not isinstance(c, types.UniTuple) or c.dtype != types.float64 or c.count != (3 if free else 15):
             return None
-        return lanes_type(w, u, wsum, bsum, diss, g_c, types.intp, types.intp, c, lanes_type, types.boolean), _codegen
+        return lanes_type(
+            w, u, wsum, bsum, diss, g_c, types.intp, types.intp, c, lanes_type, types.boolean
+        ), _codegen
 
     def _codegen(context, builder, sig, args):
         data = [context.make_array(sig.args[j])(context, builder, value=args[j]).data for j in range(6)]
@@ -1133,7 +1140,9 @@ def _group_loop(free):
         f64 = llvm_ir.DoubleType()
         v4 = llvm_ir.VectorType(f64, 4)
         i32 = llvm_ir.IntType(32)
-        fabs = cgutils.get_or_insert_function(builder.module, llvm_ir.FunctionType(v4, [v4]), "llvm.fabs.v4f64")
+        fabs = cgutils.get_or_insert_function(
+            builder.module, llvm_ir.FunctionType(v4, [v4]), "llvm.fabs.v4f64"
+        )
 
         def splat(value):
             vector = llvm_ir.Constant(v4, llvm_ir.Undefined)
@@ -1178,7 +1187,23 @@ def _group_loop(free):
                     store_to(bsum, total_b)
                 loss = mul(dx, add(zero, mul(ek_0, sub(mul(before, before), mul(after, after)))))
             else:
-                d0, d1, p00, q00, lam0, beta0, e_0, phi1_0, chi_0, cee_0, cef_0, b2, bb_cff, beta_phi, two_dx = c
+                (
+                    d0,
+                    d1,
+                    p00,
+                    q00,
+                    lam0,
+                    beta0,
+                    e_0,
+                    phi1_0,
+                    chi_0,
+                    cee_0,
+                    cef_0,
+                    b2,
+                    bb_cff,
+                    beta_phi,
+                    two_dx,
+                ) = c
                 g = load(g_c)
                 u0 = sub(d0, g)
                 u1 = sub(d1, g)
@@ -1334,7 +1359,23 @@ def _update_range_one(
     b = beta0 * slope
     b2 = 2.0 * b
     bb_cff = b * b * cff_0
-    c_in = (d0, d1, p00, q00, lam0, beta0, e_0, phi1_0, chi_0, cee_0, cef_0, b2, bb_cff, beta0 * phi1_0, 2.0 * dx)
+    c_in = (
+        d0,
+        d1,
+        p00,
+        q00,
+        lam0,
+        beta0,
+        e_0,
+        phi1_0,
+        chi_0,
+        cee_0,
+        cef_0,
+        b2,
+        bb_cff,
+        beta0 * phi1_0,
+        2.0 * dx,
+    )
     c_free = (decay_0, ek_0, dx)
     lanes = (0.0, 0.0, 0.0, 0.0, peak, peak, peak, peak)
     mid = max(min(hi, n_in), lo)
@@ -1360,7 +1401,9 @@ def _update_range_one(
         p3 = max(p3, top)
         start += 4
     groups = max(hi - start, 0) // 4
-    lanes = _groups_free(w, u, wsum, bsum, diss, g_c, start, groups, c_free, (s0, s1, s2, s3, p0, p1, p2, p3), store)
+    lanes = _groups_free(
+        w, u, wsum, bsum, diss, g_c, start, groups, c_free, (s0, s1, s2, s3, p0, p1, p2, p3), store
+    )
     start += 4 * groups
     s0, s1, s2, s3, p0, p1, p2, p3 = lanes
     for i in range(start, hi):
