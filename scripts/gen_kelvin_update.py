@@ -10,7 +10,14 @@ could not vectorise (~29 ns per element at K = 4). Written out per K, the modes 
 registers, the state is read at a known stride and the loop vectorises across elements. Each
 expression is `_chain_in_contact_k`'s / `_chain_free_k`'s, operation for operation and in the same
 order (``0.0 +`` included: it turns -0.0 into 0.0), so the results are the same bits
-(tests/test_kernel_generated.py holds the file to this output; the goldens hold the bits).
+(tests/test_kernel_generated.py holds the file to this output; the goldens hold the bits), but
+for operations that cannot change one (0.10.0, as `_update_range_one` for K = 1; the in-contact
+loop is bound by its arithmetic): each mode's ``acc = sum_k p[m, k] w[k]`` without the leading
+``0.0 +`` (it differs only as -0.0 against 0.0, which ``zeta`` carries only into the work, where a
+zero ``zeta`` leaves ``q`` the same, and ``z`` only into the back transform, whose ``0.0 +`` turns
+it); the first mode's ``work + q`` (``0.0 + q``) as ``q`` where ``q > 0``; ``2 zeta b`` as
+``zeta (2 b)`` with ``2 b`` per mode once per call (doubling is exact: the same product rounded
+once, unless it overflows).
 """
 
 from __future__ import annotations
@@ -47,6 +54,8 @@ def gen_in(K: int) -> str:
         a(f"    cee{m} = coef[_C_EE, {m}]")
         a(f"    cef{m} = coef[_C_EF, {m}]")
         a(f"    cff{m} = coef[_C_FF, {m}]")
+    for m in range(K):
+        a(f"    two_b{m} = 2.0 * (beta{m} * slope)")
     a("    two_dx = 2.0 * dx")
     a("    for i in range(_u(lo), _u(mid)):")
     a(f"        at = i * _u({K})")
@@ -56,10 +65,9 @@ def gen_in(K: int) -> str:
         a(f"        v{k} = v[at{off}]")
     a("        u0 = d0 - g_c[i]")
     a("        u1 = d1 - g_c[i]")
-    a("        work = 0.0")
     for m in range(K):
-        acc = "0.0 + " + f"p{m}0 * w0"
-        accb = "0.0 + " + f"p{m}0 * v0"
+        acc = f"p{m}0 * w0"
+        accb = f"p{m}0 * v0"
         a(f"        acc = {acc}")
         a(f"        acc_b = {accb}")
         for k in range(1, K):
@@ -69,8 +77,11 @@ def gen_in(K: int) -> str:
         a(f"        zb{m} = e{m} * acc_b + beta{m} * phi{m}")
         a(f"        zeta = beta{m} * u0 - lam{m} * acc")
         a(f"        b = beta{m} * slope")
-        a(f"        q = zeta * zeta * cee{m} + 2.0 * zeta * b * cef{m} + b * b * cff{m}")
-        a("        work = work + q if q > 0.0 else work")
+        a(f"        q = zeta * zeta * cee{m} + zeta * two_b{m} * cef{m} + b * b * cff{m}")
+        if m == 0:
+            a("        work = q if q > 0.0 else 0.0")
+        else:
+            a("        work = work + q if q > 0.0 else work")
     a("        total = 0.0")
     a("        total_b = 0.0")
     for k in range(K):

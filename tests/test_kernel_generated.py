@@ -26,6 +26,7 @@ def _row(rng: np.random.Generator, n: int, k: int):
     wl = rng.normal(scale=1e-6, size=(n, k))
     wl[rng.random((n, k)) < 0.1] = -0.0  # signed zeros: `0.0 +` must turn them the same way
     wb = rng.random((n, k))
+    wb[rng.random((n, k)) < 0.05] = -0.0
     coef = _kernels.coefficient_workspace(k)
     lam = rng.uniform(1.0, 1e4, k)
     rate = rng.uniform(1.0, 1e3, k)
@@ -43,8 +44,10 @@ def _row(rng: np.random.Generator, n: int, k: int):
     }
 
 
-@pytest.mark.parametrize("k", [2, 3, 4])
+@pytest.mark.parametrize("k", [1, 2, 3, 4])
 def test_written_out_update_equals_the_general_loop_bit_for_bit(k: int) -> None:
+    """K = 1 too: `_update_range_one` (its own loops, 0.10.0 drops operations that cannot change
+    a bit) against the same general loop, signed zeros included."""
     rng = np.random.default_rng(k)
     n = 37
     for trial in range(20):
@@ -77,3 +80,34 @@ def test_written_out_update_equals_the_general_loop_bit_for_bit(k: int) -> None:
             sums,
             want_sums,
         )
+
+
+@pytest.mark.parametrize("k", [1, 2, 3, 4])
+def test_signed_zeros_everywhere_give_the_general_loops_bits(k: int) -> None:
+    """Where every term is a signed zero (no memory, depth -0.0 or 0.0 at a zero profile), the
+    written-out updates, which leave out ``0.0 +`` where it cannot change an output (0.10.0),
+    give the general loop's bits: state, losses, peak."""
+    rng = np.random.default_rng(40 + k)
+    n = 24
+    for trial in range(12):
+        row = _row(rng, n, k)
+        row["wl"] = np.where(rng.random((n, k)) < 0.5, -0.0, 0.0)
+        row["wb"] = np.where(rng.random((n, k)) < 0.5, -0.0, 0.0)
+        row["g_c"] = np.zeros(n)
+        row["p"] = np.where(rng.random((k, k)) < 0.5, -1.0, 1.0) * rng.uniform(0.5, 2.0, (k, k))
+        depth = -0.0 if trial % 2 else 0.0
+        n_in = int(rng.integers(0, n + 1))
+        results = []
+        for general in (False, True):
+            wl, wb = row["wl"].copy(), row["wb"].copy()
+            wsum, bsum = wl.sum(axis=1), wb.sum(axis=1)
+            diss = np.full(n, np.nan)
+            args = (wl, wsum, wb, bsum, diss, 0, n, n_in, depth, depth, 0.0, row["g_c"])
+            args += (row["p"], row["p_inv"], row["lam"], row["beta"], row["coef"], row["e_kelvin"], 2e-7)
+            if general:
+                total, peak = _kernels._update_range_k(*args, 0.0, 0.0, k)
+            else:
+                total, peak = _kernels._update_range(*args, 0.0, 0.0)
+            results.append((wl, wb, wsum, bsum, diss, np.array([total, peak])))
+        for got, want in zip(results[0], results[1], strict=True):
+            assert got.tobytes() == want.tobytes(), (trial, n_in)

@@ -43,6 +43,43 @@ def test_the_losses_and_the_peak_in_four_lanes(seed: int) -> None:
         assert abs(want_total - exact) <= 2.0 * (hi - lo + 2) * EPS * exact
 
 
+def _scalar_lanes(diss, wsum, lo, hi, total, peak):
+    """The 0.7.0 `_sum_losses`: four scalar lanes (element lo + 4 j + r in lane r, the rest in
+    lane 0), as the vector lanes of `_kernels._four_lanes` (0.10.0) must give them."""
+    sums = [0.0] * 4
+    peaks = [peak] * 4
+    i = lo
+    while i + 4 <= hi:
+        for r in range(4):
+            sums[r] += diss[i + r]
+            peaks[r] = max(peaks[r], abs(wsum[i + r]))
+        i += 4
+    while i < hi:
+        sums[0] += diss[i]
+        peaks[0] = max(peaks[0], abs(wsum[i]))
+        i += 1
+    return total + ((sums[0] + sums[1]) + (sums[2] + sums[3])), max(
+        max(peaks[0], peaks[1]), max(peaks[2], peaks[3])
+    )
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_the_vector_lanes_are_the_scalar_lanes_bit_for_bit(seed: int) -> None:
+    rng = np.random.default_rng(100 + seed)
+    for _ in range(300):
+        n = int(rng.integers(1, 70))
+        diss = rng.exponential(1e-9, n) * (rng.uniform(size=n) < 0.9)
+        diss[rng.uniform(size=n) < 0.05] = -0.0
+        wsum = rng.normal(0.0, 1e-6, n)
+        wsum[rng.uniform(size=n) < 0.05] = -0.0
+        lo = int(rng.integers(0, n + 1))
+        hi = int(rng.integers(lo, n + 1))
+        total0, peak0 = float(rng.exponential(1e-8)), float(rng.exponential(1e-7)) * (rng.uniform() < 0.8)
+        got = _kernels._sum_losses(diss, wsum, lo, hi, total0, peak0)
+        want = _scalar_lanes(diss, wsum, lo, hi, total0, peak0)
+        assert np.array(got).tobytes() == np.array(want).tobytes(), (lo, hi, got, want)
+
+
 def test_an_elastic_row_keeps_no_memory_so_its_peak_is_not_scanned() -> None:
     """K = 0 (no Kelvin element): `_advance_from` reports the memory peak as 0 without the O(N)
     scan of ``wsum`` (0.7.0). That is only right if nothing ever writes a non-zero ``wsum`` on

@@ -18,7 +18,8 @@ points it is linear. The contact radius ``a`` is continuous: elements with ``x_i
 are in contact ("interior"; at least element 0 when ``a > 0``), the others are exterior.
 
 State. ``wl[i, k]`` is the elongation of Kelvin element k of element i, m; ``wsum[i]``
-their sum. Interior glass elongation ``l0 = d - g(x) - wsum``, exterior ``l0 = 0``.
+their sum (at K = 1 in a row's buffer the same memory as ``wl``, `_state_layout`). Interior
+glass elongation ``l0 = d - g(x) - wsum``, exterior ``l0 = 0``.
 The chain is linear in its input ``u_i(t) = d(t) - g(x_i)``, so its state splits exactly
 as ``wl_i = A_i - g(x_i) B_i``: ``A`` is the chain's response to ``d(t)`` and ``B``
 (``wb[i, k]``, sum ``bsum[i]``, dimensionless) its response to a unit input over the same
@@ -50,6 +51,7 @@ from typing import Any
 
 import numba
 import numpy as np
+from llvmlite import ir as llvm_ir
 from numba.core import cgutils, types
 from numba.core.imputils import impl_ret_borrowed
 from numba.extending import intrinsic
@@ -1059,40 +1061,251 @@ def _substep_coefficients(lam, rate, h, coef):
     coef[_C_CACHE_NEXT, 0] = (slot + 1) % _COEF_SLOTS
 
 
+@intrinsic
+def _four_lanes(typingctx, values, magnitudes, start, groups, peak):
+    """``(s0, s1, s2, s3, p0, p1, p2, p3)``: lane r holds ``0.0 + values[start + r] +
+    values[start + 4 + r] + ...`` (in that order) over ``groups`` groups of four, and
+    ``max(peak, |magnitudes[start + r]|, |magnitudes[start + 4 + r]|, ...)`` as numba's
+    ``max(p, abs(x))`` takes it (``abs(x) > p ? abs(x) : p``), for `_sum_losses` (0.10.0).
+    The four lanes are one 4-wide vector, so the loop is vector code (numba runs LLVM without
+    its SLP vectoriser, and the loop vectoriser may not reorder a float sum): every lane's
+    additions are the scalar loop's, in the same order, so the same bits. ``values`` and
+    ``magnitudes`` are 1D C float64 arrays holding ``start + 4 groups`` elements (unchecked)."""
+    array = types.Array(types.float64, 1, "C")
+    if values != array or magnitudes != array:
+        return None
+    signature = types.UniTuple(types.float64, 8)(values, magnitudes, types.intp, types.intp, types.float64)
+
+    def codegen(context, builder, sig, args):
+        source = context.make_array(sig.args[0])(context, builder, value=args[0])
+        other = context.make_array(sig.args[1])(context, builder, value=args[1])
+        first, count, peak_value = args[2], args[3], args[4]
+        f64 = llvm_ir.DoubleType()
+        v4 = llvm_ir.VectorType(f64, 4)
+        fabs = cgutils.get_or_insert_function(
+            builder.module, llvm_ir.FunctionType(v4, [v4]), "llvm.fabs.v4f64"
+        )
+        spread = llvm_ir.Constant(v4, llvm_ir.Undefined)
+        for lane in range(4):
+            spread = builder.insert_element(spread, peak_value, llvm_ir.Constant(llvm_ir.IntType(32), lane))
+        sums = cgutils.alloca_once_value(builder, llvm_ir.Constant(v4, [0.0, 0.0, 0.0, 0.0]))
+        peaks = cgutils.alloca_once_value(builder, spread)
+        four = llvm_ir.Constant(first.type, 4)
+        with cgutils.for_range(builder, count) as loop:
+            at = builder.add(first, builder.mul(loop.index, four))
+            lane_values = builder.load(cgutils.gep(builder, source.data, at), align=8, typ=v4)
+            lane_magnitudes = builder.load(cgutils.gep(builder, other.data, at), align=8, typ=v4)
+            builder.store(builder.fadd(builder.load(sums), lane_values), sums)
+            magnitude = builder.call(fabs, [lane_magnitudes])
+            before = builder.load(peaks)
+            builder.store(
+                builder.select(builder.fcmp_ordered(">", magnitude, before), magnitude, before), peaks
+            )
+        total = builder.load(sums)
+        top = builder.load(peaks)
+        lanes = [builder.extract_element(total, llvm_ir.Constant(llvm_ir.IntType(32), r)) for r in range(4)]
+        lanes += [builder.extract_element(top, llvm_ir.Constant(llvm_ir.IntType(32), r)) for r in range(4)]
+        return context.make_tuple(builder, sig.return_type, lanes)
+
+    return signature, codegen
+
+
+def _group_loop(free):
+    """The intrinsic that updates ``groups`` groups of four K = 1 elements from ``start`` as
+    4-wide vectors and sums their losses and |wsum| into the lanes of `_sum_losses` (given and
+    returned as ``(s0, s1, s2, s3, p0, p1, p2, p3)``), for `_update_range_one` (0.10.0):
+    in contact (``free`` False; ``c`` = d0, d1, p00, q00, lam0, beta0, e_0, phi1_0, chi_0,
+    cee_0, cef_0, 2 b, b b cff_0, beta0 phi1_0, 2 dx) or out of it (``c`` = decay_0, ek_0, dx).
+    Each vector operation is the scalar loop's, in its order (IEEE operations lane by lane:
+    the same bits), with ``diss`` written if ``store``. Numba runs LLVM without its SLP
+    vectoriser and the loop vectoriser may not reorder a float sum, so a loop that sums as
+    it goes stays scalar: written as vectors, the lanes' sums ride on the update instead of
+    a second pass over ``diss`` and ``wsum`` whose chain of additions is its whole cost."""
+    array = types.Array(types.float64, 1, "C")
+    lanes_type = types.UniTuple(types.float64, 8)
+
+    def typer(typingctx, w, u, wsum, bsum, diss, g_c, start, groups, c, lanes, store):
+        for value in (w, u, wsum, bsum, diss, g_c):
+            if value != array:
+                return None
+        if not isinstance(c, types.UniTuple) or c.dtype != types.float64 or c.count != (3 if free else 15):
+            return None
+        return lanes_type(
+            w, u, wsum, bsum, diss, g_c, types.intp, types.intp, c, lanes_type, types.boolean
+        ), _codegen
+
+    def _codegen(context, builder, sig, args):
+        data = [context.make_array(sig.args[j])(context, builder, value=args[j]).data for j in range(6)]
+        w, u, wsum, bsum, diss, g_c = data
+        first, count, constants, initial, store = args[6:]
+        # At K = 1 a row's wsum and bsum are wl and wb themselves (`_state_layout`): then
+        # the sums are not stored apart, and the one slot holds the sum's value (0.0 + x).
+        alias_w = builder.icmp_unsigned("==", wsum, w)
+        alias_b = builder.icmp_unsigned("==", bsum, u)
+        f64 = llvm_ir.DoubleType()
+        v4 = llvm_ir.VectorType(f64, 4)
+        i32 = llvm_ir.IntType(32)
+        fabs = cgutils.get_or_insert_function(
+            builder.module, llvm_ir.FunctionType(v4, [v4]), "llvm.fabs.v4f64"
+        )
+
+        def splat(value):
+            vector = llvm_ir.Constant(v4, llvm_ir.Undefined)
+            for lane in range(4):
+                vector = builder.insert_element(vector, value, llvm_ir.Constant(i32, lane))
+            return vector
+
+        c = [splat(builder.extract_value(constants, j)) for j in range(sig.args[8].count)]
+        zero = llvm_ir.Constant(v4, [0.0, 0.0, 0.0, 0.0])
+        start_sums = llvm_ir.Constant(v4, llvm_ir.Undefined)
+        start_peaks = llvm_ir.Constant(v4, llvm_ir.Undefined)
+        for lane in range(4):
+            index = llvm_ir.Constant(i32, lane)
+            start_sums = builder.insert_element(start_sums, builder.extract_value(initial, lane), index)
+            start_peaks = builder.insert_element(start_peaks, builder.extract_value(initial, 4 + lane), index)
+        sums = cgutils.alloca_once_value(builder, start_sums)
+        peaks = cgutils.alloca_once_value(builder, start_peaks)
+        four = llvm_ir.Constant(first.type, 4)
+        add, sub, mul = builder.fadd, builder.fsub, builder.fmul
+        with cgutils.for_range(builder, count) as loop:
+            at = builder.add(first, builder.mul(loop.index, four))
+
+            def load(pointer):
+                return builder.load(cgutils.gep(builder, pointer, at), align=8, typ=v4)
+
+            def store_to(pointer, value):
+                address = builder.bitcast(cgutils.gep(builder, pointer, at), v4.as_pointer())
+                builder.store(value, address, align=8)
+
+            if free:
+                decay_0, ek_0, dx = c
+                before = load(w)
+                after = mul(before, decay_0)
+                after_b = mul(load(u), decay_0)
+                total = add(zero, after)
+                total_b = add(zero, after_b)
+                store_to(w, builder.select(alias_w, total, after))
+                store_to(u, builder.select(alias_b, total_b, after_b))
+                with builder.if_then(builder.not_(alias_w)):
+                    store_to(wsum, total)
+                with builder.if_then(builder.not_(alias_b)):
+                    store_to(bsum, total_b)
+                loss = mul(dx, add(zero, mul(ek_0, sub(mul(before, before), mul(after, after)))))
+            else:
+                (
+                    d0,
+                    d1,
+                    p00,
+                    q00,
+                    lam0,
+                    beta0,
+                    e_0,
+                    phi1_0,
+                    chi_0,
+                    cee_0,
+                    cef_0,
+                    b2,
+                    bb_cff,
+                    beta_phi,
+                    two_dx,
+                ) = c
+                g = load(g_c)
+                u0 = sub(d0, g)
+                u1 = sub(d1, g)
+                acc = mul(p00, load(w))
+                acc_b = mul(p00, load(u))
+                z0 = add(mul(e_0, acc), mul(beta0, add(mul(u0, phi1_0), mul(sub(u1, u0), chi_0))))
+                zb0 = add(mul(e_0, acc_b), beta_phi)
+                zeta0 = sub(mul(beta0, u0), mul(lam0, acc))
+                q = add(add(mul(mul(zeta0, zeta0), cee_0), mul(mul(zeta0, b2), cef_0)), bb_cff)
+                work = builder.select(builder.fcmp_ordered(">", q, zero), q, zero)
+                new = add(zero, mul(q00, z0))
+                new_b = add(zero, mul(q00, zb0))
+                # new, new_b are never -0.0 (0.0 + x): the same value as their sums.
+                store_to(w, new)
+                store_to(u, new_b)
+                total = add(zero, new)
+                with builder.if_then(builder.not_(alias_w)):
+                    store_to(wsum, total)
+                with builder.if_then(builder.not_(alias_b)):
+                    store_to(bsum, add(zero, new_b))
+                loss = mul(two_dx, work)
+            with builder.if_then(store):
+                store_to(diss, loss)
+            builder.store(add(builder.load(sums), loss), sums)
+            magnitude = builder.call(fabs, [total])
+            top = builder.load(peaks)
+            builder.store(builder.select(builder.fcmp_ordered(">", magnitude, top), magnitude, top), peaks)
+        total_sums = builder.load(sums)
+        total_peaks = builder.load(peaks)
+        lanes = [builder.extract_element(total_sums, llvm_ir.Constant(i32, r)) for r in range(4)]
+        lanes += [builder.extract_element(total_peaks, llvm_ir.Constant(i32, r)) for r in range(4)]
+        return context.make_tuple(builder, sig.return_type, lanes)
+
+    return intrinsic(typer)
+
+
+_groups_in = _group_loop(False)
+_groups_free = _group_loop(True)
+
+
 @numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
 def _sum_losses(diss, wsum, lo, hi, total, peak):
     """``(total + sum(diss[lo:hi]), max(peak, max |wsum[lo:hi]|))`` in four interleaved lanes
     (0.4.0): one chain of additions in index order waited ~4 cycles per element for the one
     before (as long as the whole K = 1 update). The maxima are the same in any order; the sum
     of the losses is rounded otherwise (non-negative terms: the same value to ~1e-16 of it,
-    still >= 0; tests/golden_tolerance.py)."""
-    s0 = 0.0
-    s1 = 0.0
-    s2 = 0.0
-    s3 = 0.0
-    p0 = peak
-    p1 = peak
-    p2 = peak
-    p3 = peak
+    still >= 0; tests/golden_tolerance.py). Element ``lo + 4 j + r`` goes to lane r, the last
+    ``(hi - lo) % 4`` to lane 0; the lanes are one vector (`_four_lanes`, 0.10.0: the scalar
+    lanes cost about as much as the vectorised K = 1 update they follow)."""
+    groups = max(hi - lo, 0) // 4
+    s0, s1, s2, s3, p0, p1, p2, p3 = _four_lanes(diss, wsum, lo, groups, peak)
     one = _u(1)
-    four = _u(4)
     end = _u(hi)
-    i = _u(lo)
-    while i + four <= end:
-        s0 += diss[i]
-        s1 += diss[i + one]
-        s2 += diss[i + _u(2)]
-        s3 += diss[i + _u(3)]
-        p0 = max(p0, abs(wsum[i]))
-        p1 = max(p1, abs(wsum[i + one]))
-        p2 = max(p2, abs(wsum[i + _u(2)]))
-        p3 = max(p3, abs(wsum[i + _u(3)]))
-        i += four
+    i = _u(lo + 4 * groups)
     while i < end:
         s0 += diss[i]
         p0 = max(p0, abs(wsum[i]))
         i += one
     return total + ((s0 + s1) + (s2 + s3)), max(max(p0, p1), max(p2, p3))
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
+def _one_element(w, u, wsum, bsum, diss, g_c, i, mid, c_in, c_free):
+    """Element i of `_update_range_one` alone (in contact if i < mid; ``c_in``, ``c_free`` as
+    `_group_loop`'s ``c``): the vector loops' operations on one element. Returns its loss, J,
+    and the |wsum| it leaves, m."""
+    if i < mid:
+        d0, d1, p00, q00, lam0, beta0, e_0, phi1_0, chi_0, cee_0, cef_0, b2, bb_cff, beta_phi, two_dx = c_in
+        u0 = d0 - g_c[i]
+        u1 = d1 - g_c[i]
+        acc = p00 * w[i]
+        acc_b = p00 * u[i]
+        z0 = e_0 * acc + beta0 * (u0 * phi1_0 + (u1 - u0) * chi_0)
+        zb0 = e_0 * acc_b + beta_phi
+        zeta0 = beta0 * u0 - lam0 * acc
+        q = zeta0 * zeta0 * cee_0 + zeta0 * b2 * cef_0 + bb_cff
+        work = q if q > 0.0 else 0.0
+        new = 0.0 + q00 * z0
+        new_b = 0.0 + q00 * zb0
+        w[i] = new
+        u[i] = new_b
+        total = 0.0 + new
+        wsum[i] = total
+        bsum[i] = 0.0 + new_b
+        loss = two_dx * work
+    else:
+        decay_0, ek_0, dx = c_free
+        before = w[i]
+        after = before * decay_0
+        w[i] = after
+        u[i] = u[i] * decay_0
+        total = 0.0 + after
+        wsum[i] = total
+        bsum[i] = 0.0 + u[i]
+        loss = dx * (0.0 + ek_0 * (before * before - after * after))
+    diss[i] = loss
+    return loss, abs(total)
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
@@ -1118,12 +1331,22 @@ def _update_range_one(
     dx,
     total,
     peak,
+    store,
 ):
     """`_update_range` for one Kelvin element (K = 1), written so the compiler vectorises it:
     flat arrays, the element loops free of the running sums (taken after, `_sum_losses`).
     Each expression is `_chain_in_contact`'s / `_chain_free`'s with K = 1 spelled out,
     operation for operation (``0.0 + x`` included: it turns -0.0 into 0.0), so the results
-    are the same bits."""
+    are the same bits, but for three operations that cannot change one (0.10.0, 3 of ~32 in
+    the in-contact loop, which is bound by its arithmetic):
+
+    - the mode ``acc = p00 w`` without ``0.0 +``: it differs from ``0.0 + p00 w`` only as -0.0
+      against 0.0, and no output sees that sign: ``zeta0`` enters the work only squared or
+      times a term that is added to ``zeta0^2 cee`` (a zero ``zeta0`` leaves ``q`` the same),
+      and ``z0`` (``e acc + ...``) leaves only through ``0.0 + q00 z0`` (0.0 either way);
+    - the work ``q`` where ``q > 0`` is ``0.0 + q`` (positive, not zero);
+    - ``2 zeta0 b`` as ``zeta0 (2 b)`` with ``2 b`` once per call: doubling is exact, so both
+      round the same exact product (unless 2 b or 2 zeta0 overflows)."""
     w = _flat(wl)
     u = _flat(wb)
     p00 = p[0, 0]
@@ -1138,34 +1361,61 @@ def _update_range_one(
     cff_0 = coef[_C_FF, 0]
     decay_0 = coef[_C_DECAY, 0]
     ek_0 = e_kelvin[0]
+    b = beta0 * slope
+    b2 = 2.0 * b
+    bb_cff = b * b * cff_0
+    c_in = (
+        d0,
+        d1,
+        p00,
+        q00,
+        lam0,
+        beta0,
+        e_0,
+        phi1_0,
+        chi_0,
+        cee_0,
+        cef_0,
+        b2,
+        bb_cff,
+        beta0 * phi1_0,
+        2.0 * dx,
+    )
+    c_free = (decay_0, ek_0, dx)
+    lanes = (0.0, 0.0, 0.0, 0.0, peak, peak, peak, peak)
     mid = max(min(hi, n_in), lo)
-    for i in range(_u(lo), _u(mid)):
-        u0 = d0 - g_c[i]
-        u1 = d1 - g_c[i]
-        acc = 0.0 + p00 * w[i]
-        acc_b = 0.0 + p00 * u[i]
-        z0 = e_0 * acc + beta0 * (u0 * phi1_0 + (u1 - u0) * chi_0)
-        zb0 = e_0 * acc_b + beta0 * phi1_0
-        zeta0 = beta0 * u0 - lam0 * acc
-        b = beta0 * slope
-        q = zeta0 * zeta0 * cee_0 + 2.0 * zeta0 * b * cef_0 + b * b * cff_0
-        work = 0.0 + q if q > 0.0 else 0.0
-        new = 0.0 + q00 * z0
-        new_b = 0.0 + q00 * zb0
-        w[i] = new
-        u[i] = new_b
-        wsum[i] = 0.0 + new
-        bsum[i] = 0.0 + new_b
-        diss[i] = 2.0 * dx * work
-    for i in range(_u(mid), _u(hi)):
-        before = w[i]
-        after = before * decay_0
-        w[i] = after
-        u[i] = u[i] * decay_0
-        wsum[i] = 0.0 + after
-        bsum[i] = 0.0 + u[i]
-        diss[i] = dx * (0.0 + ek_0 * (before * before - after * after))
-    return _sum_losses(diss, wsum, lo, hi, total, peak)
+    # Whole groups of four in contact, the group the edge splits (element by element), whole
+    # groups out of contact, the rest (element by element, lane 0): `_sum_losses`'s lanes.
+    start = lo
+    groups = (mid - lo) // 4
+    lanes = _groups_in(w, u, wsum, bsum, diss, g_c, start, groups, c_in, lanes, store)
+    start += 4 * groups
+    s0, s1, s2, s3, p0, p1, p2, p3 = lanes
+    if start < mid and start + 4 <= hi:
+        loss, top = _one_element(w, u, wsum, bsum, diss, g_c, start, mid, c_in, c_free)
+        s0 += loss
+        p0 = max(p0, top)
+        loss, top = _one_element(w, u, wsum, bsum, diss, g_c, start + 1, mid, c_in, c_free)
+        s1 += loss
+        p1 = max(p1, top)
+        loss, top = _one_element(w, u, wsum, bsum, diss, g_c, start + 2, mid, c_in, c_free)
+        s2 += loss
+        p2 = max(p2, top)
+        loss, top = _one_element(w, u, wsum, bsum, diss, g_c, start + 3, mid, c_in, c_free)
+        s3 += loss
+        p3 = max(p3, top)
+        start += 4
+    groups = max(hi - start, 0) // 4
+    lanes = _groups_free(
+        w, u, wsum, bsum, diss, g_c, start, groups, c_free, (s0, s1, s2, s3, p0, p1, p2, p3), store
+    )
+    start += 4 * groups
+    s0, s1, s2, s3, p0, p1, p2, p3 = lanes
+    for i in range(start, hi):
+        loss, top = _one_element(w, u, wsum, bsum, diss, g_c, i, mid, c_in, c_free)
+        s0 += loss
+        p0 = max(p0, top)
+    return total + ((s0 + s1) + (s2 + s3)), max(max(p0, p1), max(p2, p3))
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
@@ -1191,16 +1441,19 @@ def _update_range(
     dx,
     total,
     peak,
+    store=True,
 ):
     """`_kelvin_update` of elements lo..hi-1 with the coefficients in ``coef`` (one substep,
     `_substep_coefficients`); returns ``(total, peak)``: ``total`` plus the energy they
     dissipated, J (K <= 4: in four lanes, `_sum_losses`; K > 4: element by element in index
-    order), and the larger of ``peak`` and their largest |wsum|, m."""
+    order), and the larger of ``peak`` and their largest |wsum|, m. ``diss[i]`` gets element
+    i's loss; with ``store`` False it may not (K = 1 leaves it out: `_advance_from` reads
+    ``diss`` per element only over a substep's trial window, 0.10.0)."""
     k_count = wl.shape[1]
     args = (wl, wsum, wb, bsum, diss, lo, hi, n_in, d0, d1, slope, g_c, p, p_inv, lam, beta, coef)
     args = (*args, e_kelvin, dx)
     if k_count == 1:
-        return _update_range_one(*args, total, peak)
+        return _update_range_one(*args, total, peak, store)
     if k_count < 2 or k_count > 4:
         return _update_range_k(*args, total, peak, k_count)
     # K = 2, 3, 4: the element loops written out per K (generated, `_update_in_4`...): the modes
@@ -1325,6 +1578,8 @@ def _update_in_2(wl, wsum, wb, bsum, diss, lo, mid, d0, d1, slope, g_c, p, p_inv
     cee1 = coef[_C_EE, 1]
     cef1 = coef[_C_EF, 1]
     cff1 = coef[_C_FF, 1]
+    two_b0 = 2.0 * (beta0 * slope)
+    two_b1 = 2.0 * (beta1 * slope)
     two_dx = 2.0 * dx
     for i in range(_u(lo), _u(mid)):
         at = i * _u(2)
@@ -1334,26 +1589,25 @@ def _update_in_2(wl, wsum, wb, bsum, diss, lo, mid, d0, d1, slope, g_c, p, p_inv
         v1 = v[at + _u(1)]
         u0 = d0 - g_c[i]
         u1 = d1 - g_c[i]
-        work = 0.0
-        acc = 0.0 + p00 * w0
-        acc_b = 0.0 + p00 * v0
+        acc = p00 * w0
+        acc_b = p00 * v0
         acc = acc + p01 * w1
         acc_b = acc_b + p01 * v1
         z0 = e0 * acc + beta0 * (u0 * phi0 + (u1 - u0) * chi0)
         zb0 = e0 * acc_b + beta0 * phi0
         zeta = beta0 * u0 - lam0 * acc
         b = beta0 * slope
-        q = zeta * zeta * cee0 + 2.0 * zeta * b * cef0 + b * b * cff0
-        work = work + q if q > 0.0 else work
-        acc = 0.0 + p10 * w0
-        acc_b = 0.0 + p10 * v0
+        q = zeta * zeta * cee0 + zeta * two_b0 * cef0 + b * b * cff0
+        work = q if q > 0.0 else 0.0
+        acc = p10 * w0
+        acc_b = p10 * v0
         acc = acc + p11 * w1
         acc_b = acc_b + p11 * v1
         z1 = e1 * acc + beta1 * (u0 * phi1 + (u1 - u0) * chi1)
         zb1 = e1 * acc_b + beta1 * phi1
         zeta = beta1 * u0 - lam1 * acc
         b = beta1 * slope
-        q = zeta * zeta * cee1 + 2.0 * zeta * b * cef1 + b * b * cff1
+        q = zeta * zeta * cee1 + zeta * two_b1 * cef1 + b * b * cff1
         work = work + q if q > 0.0 else work
         total = 0.0
         total_b = 0.0
@@ -1460,6 +1714,9 @@ def _update_in_3(wl, wsum, wb, bsum, diss, lo, mid, d0, d1, slope, g_c, p, p_inv
     cee2 = coef[_C_EE, 2]
     cef2 = coef[_C_EF, 2]
     cff2 = coef[_C_FF, 2]
+    two_b0 = 2.0 * (beta0 * slope)
+    two_b1 = 2.0 * (beta1 * slope)
+    two_b2 = 2.0 * (beta2 * slope)
     two_dx = 2.0 * dx
     for i in range(_u(lo), _u(mid)):
         at = i * _u(3)
@@ -1471,9 +1728,8 @@ def _update_in_3(wl, wsum, wb, bsum, diss, lo, mid, d0, d1, slope, g_c, p, p_inv
         v2 = v[at + _u(2)]
         u0 = d0 - g_c[i]
         u1 = d1 - g_c[i]
-        work = 0.0
-        acc = 0.0 + p00 * w0
-        acc_b = 0.0 + p00 * v0
+        acc = p00 * w0
+        acc_b = p00 * v0
         acc = acc + p01 * w1
         acc_b = acc_b + p01 * v1
         acc = acc + p02 * w2
@@ -1482,10 +1738,10 @@ def _update_in_3(wl, wsum, wb, bsum, diss, lo, mid, d0, d1, slope, g_c, p, p_inv
         zb0 = e0 * acc_b + beta0 * phi0
         zeta = beta0 * u0 - lam0 * acc
         b = beta0 * slope
-        q = zeta * zeta * cee0 + 2.0 * zeta * b * cef0 + b * b * cff0
-        work = work + q if q > 0.0 else work
-        acc = 0.0 + p10 * w0
-        acc_b = 0.0 + p10 * v0
+        q = zeta * zeta * cee0 + zeta * two_b0 * cef0 + b * b * cff0
+        work = q if q > 0.0 else 0.0
+        acc = p10 * w0
+        acc_b = p10 * v0
         acc = acc + p11 * w1
         acc_b = acc_b + p11 * v1
         acc = acc + p12 * w2
@@ -1494,10 +1750,10 @@ def _update_in_3(wl, wsum, wb, bsum, diss, lo, mid, d0, d1, slope, g_c, p, p_inv
         zb1 = e1 * acc_b + beta1 * phi1
         zeta = beta1 * u0 - lam1 * acc
         b = beta1 * slope
-        q = zeta * zeta * cee1 + 2.0 * zeta * b * cef1 + b * b * cff1
+        q = zeta * zeta * cee1 + zeta * two_b1 * cef1 + b * b * cff1
         work = work + q if q > 0.0 else work
-        acc = 0.0 + p20 * w0
-        acc_b = 0.0 + p20 * v0
+        acc = p20 * w0
+        acc_b = p20 * v0
         acc = acc + p21 * w1
         acc_b = acc_b + p21 * v1
         acc = acc + p22 * w2
@@ -1506,7 +1762,7 @@ def _update_in_3(wl, wsum, wb, bsum, diss, lo, mid, d0, d1, slope, g_c, p, p_inv
         zb2 = e2 * acc_b + beta2 * phi2
         zeta = beta2 * u0 - lam2 * acc
         b = beta2 * slope
-        q = zeta * zeta * cee2 + 2.0 * zeta * b * cef2 + b * b * cff2
+        q = zeta * zeta * cee2 + zeta * two_b2 * cef2 + b * b * cff2
         work = work + q if q > 0.0 else work
         total = 0.0
         total_b = 0.0
@@ -1659,6 +1915,10 @@ def _update_in_4(wl, wsum, wb, bsum, diss, lo, mid, d0, d1, slope, g_c, p, p_inv
     cee3 = coef[_C_EE, 3]
     cef3 = coef[_C_EF, 3]
     cff3 = coef[_C_FF, 3]
+    two_b0 = 2.0 * (beta0 * slope)
+    two_b1 = 2.0 * (beta1 * slope)
+    two_b2 = 2.0 * (beta2 * slope)
+    two_b3 = 2.0 * (beta3 * slope)
     two_dx = 2.0 * dx
     for i in range(_u(lo), _u(mid)):
         at = i * _u(4)
@@ -1672,9 +1932,8 @@ def _update_in_4(wl, wsum, wb, bsum, diss, lo, mid, d0, d1, slope, g_c, p, p_inv
         v3 = v[at + _u(3)]
         u0 = d0 - g_c[i]
         u1 = d1 - g_c[i]
-        work = 0.0
-        acc = 0.0 + p00 * w0
-        acc_b = 0.0 + p00 * v0
+        acc = p00 * w0
+        acc_b = p00 * v0
         acc = acc + p01 * w1
         acc_b = acc_b + p01 * v1
         acc = acc + p02 * w2
@@ -1685,10 +1944,10 @@ def _update_in_4(wl, wsum, wb, bsum, diss, lo, mid, d0, d1, slope, g_c, p, p_inv
         zb0 = e0 * acc_b + beta0 * phi0
         zeta = beta0 * u0 - lam0 * acc
         b = beta0 * slope
-        q = zeta * zeta * cee0 + 2.0 * zeta * b * cef0 + b * b * cff0
-        work = work + q if q > 0.0 else work
-        acc = 0.0 + p10 * w0
-        acc_b = 0.0 + p10 * v0
+        q = zeta * zeta * cee0 + zeta * two_b0 * cef0 + b * b * cff0
+        work = q if q > 0.0 else 0.0
+        acc = p10 * w0
+        acc_b = p10 * v0
         acc = acc + p11 * w1
         acc_b = acc_b + p11 * v1
         acc = acc + p12 * w2
@@ -1699,10 +1958,10 @@ def _update_in_4(wl, wsum, wb, bsum, diss, lo, mid, d0, d1, slope, g_c, p, p_inv
         zb1 = e1 * acc_b + beta1 * phi1
         zeta = beta1 * u0 - lam1 * acc
         b = beta1 * slope
-        q = zeta * zeta * cee1 + 2.0 * zeta * b * cef1 + b * b * cff1
+        q = zeta * zeta * cee1 + zeta * two_b1 * cef1 + b * b * cff1
         work = work + q if q > 0.0 else work
-        acc = 0.0 + p20 * w0
-        acc_b = 0.0 + p20 * v0
+        acc = p20 * w0
+        acc_b = p20 * v0
         acc = acc + p21 * w1
         acc_b = acc_b + p21 * v1
         acc = acc + p22 * w2
@@ -1713,10 +1972,10 @@ def _update_in_4(wl, wsum, wb, bsum, diss, lo, mid, d0, d1, slope, g_c, p, p_inv
         zb2 = e2 * acc_b + beta2 * phi2
         zeta = beta2 * u0 - lam2 * acc
         b = beta2 * slope
-        q = zeta * zeta * cee2 + 2.0 * zeta * b * cef2 + b * b * cff2
+        q = zeta * zeta * cee2 + zeta * two_b2 * cef2 + b * b * cff2
         work = work + q if q > 0.0 else work
-        acc = 0.0 + p30 * w0
-        acc_b = 0.0 + p30 * v0
+        acc = p30 * w0
+        acc_b = p30 * v0
         acc = acc + p31 * w1
         acc_b = acc_b + p31 * v1
         acc = acc + p32 * w2
@@ -1727,7 +1986,7 @@ def _update_in_4(wl, wsum, wb, bsum, diss, lo, mid, d0, d1, slope, g_c, p, p_inv
         zb3 = e3 * acc_b + beta3 * phi3
         zeta = beta3 * u0 - lam3 * acc
         b = beta3 * slope
-        q = zeta * zeta * cee3 + 2.0 * zeta * b * cef3 + b * b * cff3
+        q = zeta * zeta * cee3 + zeta * two_b3 * cef3 + b * b * cff3
         work = work + q if q > 0.0 else work
         total = 0.0
         total_b = 0.0
@@ -2900,6 +3159,7 @@ def _advance_from(
                 dx,
                 0.0,
                 0.0,
+                False,
             )
         hysteresis = _retime_crossed(
             wl,
@@ -2955,6 +3215,7 @@ def _advance_from(
                 dx,
                 viscous,
                 peak,
+                False,
             )
             if last and not whole and (t_lo > 0 or t_hi < n):
                 # The deferred elements in one update over the whole step (exact for a depth
@@ -2982,6 +3243,7 @@ def _advance_from(
                     dx,
                     viscous,
                     peak,
+                    False,
                 )
                 viscous, peak = _update_range(
                     wl,
@@ -3005,6 +3267,7 @@ def _advance_from(
                     dx,
                     viscous,
                     peak,
+                    False,
                 )
             if last:
                 t_lo = 0
@@ -3097,6 +3360,7 @@ def _advance_from(
                 dx,
                 viscous,
                 0.0,
+                False,
             )
             viscous, _ = _update_range(
                 wl,
@@ -3120,6 +3384,7 @@ def _advance_from(
                 dx,
                 viscous,
                 0.0,
+                False,
             )
             lost += viscous
             t_lo = 0
@@ -3474,22 +3739,25 @@ def _fill_regrid(const, state, chain_from, g_c, gf, gint, wl, wb, dx, df, e0, c_
     first = chain_from.shape[0] - chain
     for j in range(chain):
         const[at + j] = chain_from[first + j]
-    # state: wl, wsum, wb, bsum, scratch, scratch_b, diss, out, txn, txn_b, coef
+    # state: wl, wsum, wb, bsum, scratch, scratch_b, diss, out, txn, txn_b, coef (K = 1: wl,
+    # wb, scratch, ...: wsum and bsum are wl and wb, `_state_layout`)
     size = n * k
-    at = size + n
-    for i in range(n):
-        for kk in range(k):
-            state[i * k + kk] = wl[i, kk]
-            state[at + i * k + kk] = wb[i, kk]
     if k == 1:
-        # numpy's wl.sum(axis=1) over one column: 0.0 + w (a -0.0 becomes +0.0).
+        # numpy's wl.sum(axis=1) over one column: 0.0 + w (a -0.0 becomes +0.0); the slot
+        # holds the sum's value.
         for i in range(n):
             total = 0.0
             total += wl[i, 0]
-            state[size + i] = total
+            state[i] = total
             total_b = 0.0
             total_b += wb[i, 0]
-            state[2 * size + n + i] = total_b
+            state[n + i] = total_b
+    else:
+        at = size + n
+        for i in range(n):
+            for kk in range(k):
+                state[i * k + kk] = wl[i, kk]
+                state[at + i * k + kk] = wb[i, kk]
     coef_at = state.shape[0] - COEF_ROWS * max(k, 1)
     _clear_coefficients(state[coef_at:].reshape((COEF_ROWS, max(k, 1))))
     return -1
@@ -3532,12 +3800,24 @@ PACK_HEADER = 10
 
 @functools.lru_cache(maxsize=256)
 def _state_layout(n: int, k: int) -> tuple[tuple[str, tuple[int, ...]], ...]:
-    """The arrays in `Row._state`, in order, with their shapes (`_unpack` mirrors it)."""
+    """The arrays in `Row._state`, in order, with their shapes (`_unpack` mirrors it). At
+    K = 1 ``wsum`` and ``bsum`` have no place of their own: they are ``wl`` and ``wb`` seen
+    as (N,) (`_STATE_ALIASES`, 0.10.0): the sum over one mode is the mode (as ``0.0 + x``:
+    the slot holds the sum's value, -0.0 turned to 0.0), and the K = 1 update then stores
+    each element's state once instead of twice (the free elements' loop is bound by its
+    stores: about a quarter of the K = 1 update)."""
+    if k == 1:
+        return (("wl", (n, k)), ("wb", (n, k)), *_state_rest(n, k))
+    return (("wl", (n, k)), ("wsum", (n,)), ("wb", (n, k)), ("bsum", (n,)), *_state_rest(n, k))
+
+
+#: The state views that are another view's memory at K = 1 (`_state_layout`).
+_STATE_ALIASES = {"wsum": "wl", "bsum": "wb"}
+
+
+def _state_rest(n: int, k: int) -> tuple[tuple[str, tuple[int, ...]], ...]:
+    """`_state_layout` after the memory and its sums."""
     return (
-        ("wl", (n, k)),
-        ("wsum", (n,)),
-        ("wb", (n, k)),
-        ("bsum", (n,)),
         ("scratch", (n, k)),
         ("scratch_b", (n, k)),
         ("diss", (n,)),
@@ -3569,7 +3849,7 @@ def _const_layout(n: int, k: int, m: int, blocks: int) -> tuple[tuple[str, tuple
     )
 
 
-_VIEW_NAMES = frozenset(name for name, _ in _state_layout(1, 1) + _const_layout(1, 1, 2, 1))
+_VIEW_NAMES = frozenset(name for name, _ in _state_layout(1, 2) + _const_layout(1, 1, 2, 1))
 #: What a pickled (or deep-copied) row leaves behind: the views and the buffers' addresses.
 _NOT_PICKLED = _VIEW_NAMES | {"addresses", "gint_kernel"}
 
@@ -3607,6 +3887,10 @@ def _row_slots(n: int, k: int, m: int, blocks: int) -> dict[str, tuple[bool, int
     slots.update(
         {name: (True, first, end, shape) for name, first, end, shape in _slots(0, _state_layout(n, k))}
     )
+    if k == 1:
+        for name, owner in _STATE_ALIASES.items():
+            _, first, end, _ = slots[owner]
+            slots[name] = (True, first, end, (n,))
     # What the kernels take as ``gint``: the profile's integral with the force weights after
     # it, one array (`_deviation_integral` reads the weights from there).
     _, first, _, _ = slots["gint"]
@@ -3619,6 +3903,15 @@ def _views(buffer: np.ndarray, start: int, layout: tuple[tuple[str, tuple[int, .
     """(name, view) of each array of `layout` in `buffer` from `start` on."""
     for name, first, end, shape in _slots(start, layout):
         yield name, buffer[first:end].reshape(shape)
+
+
+def _state_views(buffer: np.ndarray, n: int, k: int):
+    """(name, view) of each array of a row's state buffer ``buffer`` (`_state_layout`), the
+    K = 1 aliases included."""
+    for name, first, end, shape in _slots(0, _state_layout(n, k)):
+        yield name, buffer[first:end].reshape(shape)
+        if k == 1 and name in ("wl", "wb"):
+            yield ("wsum" if name == "wl" else "bsum"), buffer[first:end]
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
@@ -3650,13 +3943,15 @@ def _unpack_at(s, c):
     nk = n * k
     o = 0
     wl = _view(s, o, (n, k))
+    # K = 1: wsum and bsum are wl and wb (`_state_layout`).
+    sums = 0 if k == 1 else n
     o += nk
-    wsum = _view(s, o, n)
-    o += n
+    wsum = _view(s, o - nk if k == 1 else o, n)
+    o += sums
     wb = _view(s, o, (n, k))
     o += nk
-    bsum = _view(s, o, n)
-    o += n
+    bsum = _view(s, o - nk if k == 1 else o, n)
+    o += sums
     scratch = _view(s, o, (n, k))
     o += nk
     scratch_b = _view(s, o, (n, k))
@@ -4104,7 +4399,7 @@ class Row:
         n, k, m, blocks = (int(v) for v in self._const[:4])
         for name, view in _views(self._const, PACK_HEADER, _const_layout(n, k, m, blocks)):
             setattr(self, name, view)
-        for name, view in _views(self._state, 0, _state_layout(n, k)):
+        for name, view in _state_views(self._state, n, k):
             setattr(self, name, view)
         _, first, end, _ = _row_slots(n, k, m, blocks)["gint_kernel"]
         self.gint_kernel = self._const[first:end]
@@ -4180,7 +4475,7 @@ class Row:
         clone.__dict__.update(self.__dict__)
         clone.__dict__.pop("addresses", None)  # its own state buffer
         clone._state = np.zeros_like(self._state)
-        for name, view in _views(clone._state, 0, _state_layout(*self.wl.shape)):
+        for name, view in _state_views(clone._state, *self.wl.shape):
             setattr(clone, name, view)
         clone.coef[...] = coefficient_workspace(self.wl.shape[1])
         clone._kernel_args = None
