@@ -51,7 +51,7 @@ def kelvin(ratio: float, chain: int) -> tuple[list[float], list[float]]:
     compliance = (ratio - 1.0) / G0 / chain  # 1/G_inf - 1/G0 shared equally
     moduli = [1.0 / compliance] * chain
     times = [TAU * 30.0 ** (k - (chain - 1) / 2.0) for k in range(chain)]
-    return moduli, [t * (G0 + g) for t, g in zip(times, moduli)]
+    return moduli, [t * (G0 + g) for t, g in zip(times, moduli, strict=True)]
 
 
 def history(contact, depth: float, presses: float) -> tuple[np.ndarray, np.ndarray]:
@@ -112,7 +112,7 @@ def main() -> None:
                     if math.isnan(peak):
                         cells.append(f"{depth:g}: no pull-off")
                         continue
-                    c = max(e * n * n for e, n in zip(errs, LADDER))
+                    c = max(e * n * n for e, n in zip(errs, LADDER, strict=True))
                     rows.append((chain, ratio, presses, depth, peak, errs))
                     cells.append(f"{depth:g}: C {c:.3g} (ratio {peak:.0f}, err@384 {errs[-1]:.1e})")
                 print(f"K={chain} r={ratio:g} p={presses:g}: " + ", ".join(cells), flush=True)
@@ -124,26 +124,42 @@ def main() -> None:
     print("Envelope of C / r over p and D, per body (RATIO_TERM is this with a 20 % margin):")
     for chain in (1, 3):
         for ratio in sorted({r for k, r, *_ in rows if k == chain}):
-            inside = [max(e * n * n for e, n in zip(row[5], LADDER)) for row in rows if row[:2] == (chain, ratio) and covered(row)]
-            print(f"  K={chain} r={ratio:g}: C/r {max(inside) / ratio:.3g} (C {max(inside):.3g}, {len(inside)} histories)")
+            inside = [
+                max(e * n * n for e, n in zip(row[5], LADDER, strict=True))
+                for row in rows
+                if row[:2] == (chain, ratio) and covered(row)
+            ]
+            print(
+                f"  K={chain} r={ratio:g}: C/r {max(inside) / ratio:.3g} "
+                f"(C {max(inside):.3g}, {len(inside)} histories)"
+            )
     print("Largest measured / predicted error (presets.predicted_error at N = 96, 192, 384):")
     for label, keep in (
         ("covered", covered),
-        (f"deeper than {RATIO_DEPTH:g} d_c, peak <= {RATIO_PEAK:g} r", lambda row: row[3] > RATIO_DEPTH and row[4] <= RATIO_PEAK * row[1]),
-        (f"peak > {RATIO_PEAK:g} r |F_pull-off| (a pull-off small against the peak)", lambda row: row[4] > RATIO_PEAK * row[1]),
+        (
+            f"deeper than {RATIO_DEPTH:g} d_c, peak <= {RATIO_PEAK:g} r",
+            lambda row: row[3] > RATIO_DEPTH and row[4] <= RATIO_PEAK * row[1],
+        ),
+        (
+            f"peak > {RATIO_PEAK:g} r |F_pull-off| (a pull-off small against the peak)",
+            lambda row: row[4] > RATIO_PEAK * row[1],
+        ),
     ):
         worst = (0.0, None)
         for row in rows:
             if not keep(row):
                 continue
             regime = "viscoelastic" if row[0] == 1 else "viscoelastic, K >= 2"
-            for e, n in zip(row[5], LADDER):
+            for e, n in zip(row[5], LADDER, strict=True):
                 worst = max(worst, (e / predicted_error(regime, n, row[1]), (row[:5], n)), key=lambda w: w[0])
         if worst[1] is None:
             print(f"  {label}: none")
             continue
         (chain, ratio, presses, depth, peak), n = worst[1]
-        print(f"  {label}: {worst[0]:.2f} (K={chain} r={ratio:g} p={presses:g} D={depth:g} ratio {peak:.0f}, N={n})")
+        print(
+            f"  {label}: {worst[0]:.2f} "
+            f"(K={chain} r={ratio:g} p={presses:g} D={depth:g} ratio {peak:.0f}, N={n})"
+        )
 
 
 if __name__ == "__main__":

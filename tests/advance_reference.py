@@ -14,7 +14,6 @@ import math
 import numba
 
 from viscoadh_ros.core._kernels import (
-    _adhesion_loss,
     _ATTEMPTS_PER_ELEMENT,
     _MAX_ATTEMPTS,
     _MAX_TOUCH_PLANS,
@@ -30,6 +29,7 @@ from viscoadh_ros.core._kernels import (
     OUT_WORK,
     STATUS_GROW,
     STATUS_OK,
+    _adhesion_loss,
     _copy_range,
     _edge_outputs,
     _first_touch,

@@ -307,7 +307,15 @@ def test_energy_dissipated_never_decreases_under_force_control(model: str) -> No
         ({"shape": "power_law", "coefficient": 0.5 / math.sqrt(R), "exponent": 1.5}, 300.0, 0.01),
         ({"shape": "sphere", "radius": R}, 300.0, 0.01),
     ],
-    ids=["blunt cone", "blunt cone 2400", "cone 80", "steep cone 70", "steep cone 70 2400", "power law 1.5", "sphere"],
+    ids=[
+        "blunt cone",
+        "blunt cone 2400",
+        "cone 80",
+        "steep cone 70",
+        "steep cone 70 2400",
+        "power law 1.5",
+        "sphere",
+    ],
 )
 def test_deep_cycle_dissipates_the_jkr_losses(indenter, deepest, bound) -> None:
     """Pressed from -0.5 d_c to `deepest` d_c and pulled to -3 d_c in 1000 rows (d_c of the

@@ -25,8 +25,8 @@ from viscoadh_ros.core.errors import ConfigError
 from viscoadh_ros.core.history import simulate_history
 from viscoadh_ros.core.presets import (
     ELEMENT_LADDER,
-    SceneHint,
     UNKNOWN_RATIO,
+    SceneHint,
     numerics_for_tolerance,
     relaxation_times,
     relaxed_ratio,
@@ -117,7 +117,9 @@ def test_the_regime_is_recognised_from_the_material_and_the_time_scale() -> None
     assert k3.regime == "viscoelastic, K >= 2"
     assert numerics_for_tolerance(1e-3, None).elements == k3.elements
     # A larger G0/G_inf never gets fewer elements (the viscoelastic error grows with it).
-    counts = [numerics_for_tolerance(1e-2, SceneHint((1e-3,), "sphere", r)).elements for r in (1.1, 11, 101, 1001)]
+    counts = [
+        numerics_for_tolerance(1e-2, SceneHint((1e-3,), "sphere", r)).elements for r in (1.1, 11, 101, 1001)
+    ]
     assert counts == sorted(counts) and counts[0] < counts[-1], counts
 
 
@@ -186,7 +188,11 @@ def test_a_large_glass_to_relaxed_ratio_gets_the_elements_its_tolerance_needs(to
     result = simulate_history(contact, times, depth=depths)
     converged = simulate_history(paper(preset="accurate", elements=4096), times, depth=depths)
     case = CASES["partly relaxed"]  # only for cc.errors' branch rows (same 1001-row layout)
-    entry = {"force": converged.force, "radius": converged.contact_radius, "dissipated": converged.energy_dissipated}
+    entry = {
+        "force": converged.force,
+        "radius": converged.contact_radius,
+        "dissipated": converged.energy_dissipated,
+    }
     error = _force_error(case, result, entry)
     elements = ContactSimulator(contact).numerics.elements
     assert error <= tolerance, f"tolerance {tolerance:g}: {elements} elements give {error:.2e}"
