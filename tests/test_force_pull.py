@@ -234,3 +234,38 @@ def test_the_aimed_detachment_ends_where_the_bisection_ends(name: str) -> None:
         assert abs(a.depth - b.depth) <= 10.0 * tolerance * depth_scale, (index, a.depth, b.depth)
     assert new_trials.max() < old_trials.max(), (new_trials.max(), old_trials.max())
     assert new_trials.sum() < old_trials.sum()
+
+
+def test_a_push_back_from_a_pull_held_at_zero_depth_takes_few_trials() -> None:
+    """An outside tester (0.10.0): a sphere pulled at -1000 N past its pull-off and held there
+    while the surface creeps back (it touches at a held depth of ~1e-21 m and lets go again),
+    then pushed back: the push-back's first row (-800 N) ran the dip's golden section onto an
+    attached trial at ~1e-21 m, every interior trial detached, down to 1e-10 of that depth:
+    98 trials (0.9.0: 6). The section now also stops on the attached values it knows at its
+    ends and at its best trial (`ContactSimulator._search_dip`)."""
+    sim = _Counting(
+        one_contact(
+            {"shape": "sphere", "radius": 1e-3},
+            kelvin=[2e5],
+            viscosities=[1.2e3],
+            work=0.05,
+            numerics={"model": "time_stepped", "tolerance": 1e-2},
+        )
+    )
+    press, pull, dt = 2e-3, -1e3, 1e-3
+    forces = (
+        [press * i / 20 for i in range(1, 21)]
+        + [press] * 20
+        + [press + (pull - press) * i / 20 for i in range(1, 21)]
+        + [pull] * 200
+        + [pull + (press - pull) * i / 20 for i in range(1, 21)]
+        + [press] * 20
+    )
+    trials = []
+    for i, force in enumerate(forces):
+        out = sim.step((i + 1) * dt, force=force)
+        trials.append(sim.trials)
+    push_back = 260
+    assert sim.output.contact_radius > 0.0 and abs(out.force - press) <= 1e-2 * press
+    assert max(trials[push_back : push_back + 5]) <= 12, trials[push_back : push_back + 5]
+    assert max(trials) <= 40, max(trials)
