@@ -290,7 +290,8 @@ RATIO_KNEE, RATIO_GROWTH = 101.0, 0.6
 RATIO_DEPTH, RATIO_PEAK = 10.0, 4.0
 #: A body counts as glassy over the time scale T when its shortest relaxation time is at least
 #: T / (GLASSY_FRACTION * tolerance): its memory then moves less than a tenth of the
-#: tolerance over T. Anything else viscoelastic takes the viscoelastic model (relaxed bodies
+#: tolerance over T, relative to the peak force (relative to the pull-off force it can move
+#: much more: docs/configuration.md). Anything else viscoelastic takes the viscoelastic model (relaxed bodies
 #: included: the study shows no smaller error for them).
 GLASSY_FRACTION = 0.1
 
