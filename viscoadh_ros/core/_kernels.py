@@ -3871,7 +3871,9 @@ def _const_layout(n: int, k: int, m: int, blocks: int) -> tuple[tuple[str, tuple
     )
 
 
-_VIEW_NAMES = frozenset(name for name, _ in _state_layout(1, 2) + _const_layout(1, 1, 2, 1))
+_VIEW_NAMES = frozenset(name for name, _ in _state_layout(1, 1) + _const_layout(1, 1, 2, 1)) | set(
+    _STATE_ALIASES
+)
 #: What a pickled (or deep-copied) row leaves behind: the views and the buffers' addresses.
 _NOT_PICKLED = _VIEW_NAMES | {"addresses", "gint_kernel"}
 
@@ -3932,8 +3934,10 @@ def _state_views(buffer: np.ndarray, n: int, k: int):
     K = 1 aliases included."""
     for name, first, end, shape in _slots(0, _state_layout(n, k)):
         yield name, buffer[first:end].reshape(shape)
-        if k == 1 and name in ("wl", "wb"):
-            yield ("wsum" if name == "wl" else "bsum"), buffer[first:end]
+        if k == 1:
+            for alias, owner in _STATE_ALIASES.items():
+                if name == owner:
+                    yield alias, buffer[first:end]
 
 
 @numba.njit(cache=True, nogil=True, inline="always")

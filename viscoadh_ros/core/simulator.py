@@ -2600,8 +2600,8 @@ class ContactSimulator:
         attached = [i for i, (_, _, r) in enumerate(samples) if r > 0.0]
         if attached and golden_section:
             j = min(attached, key=lambda i: samples[i][1])
-            a = samples[max(j - 1, 0)][0]
-            b = samples[min(j + 1, len(samples) - 1)][0]
+            left, right = samples[max(j - 1, 0)], samples[min(j + 1, len(samples) - 1)]
+            a, b = left[0], right[0]
             golden = 0.5 * (math.sqrt(5.0) - 1.0)
 
             def value(x: float) -> float:
@@ -2615,10 +2615,7 @@ class ContactSimulator:
             # The residuals known at the bracket's ends (+inf where detached) and at the
             # smallest attached trial j, which the bracket holds until it shrinks past it.
             x_j, r_j = samples[j][0], samples[j][1] - target
-            ra = samples[max(j - 1, 0)][1] - target if samples[max(j - 1, 0)][2] > 0.0 else math.inf
-            rb = samples[min(j + 1, len(samples) - 1)][1] - target
-            if not samples[min(j + 1, len(samples) - 1)][2] > 0.0:
-                rb = math.inf
+            ra, rb = (f - target if r > 0.0 else math.inf for _, f, r in (left, right))
             c = b - golden * (b - a)
             d = a + golden * (b - a)
             rc = value(c)
