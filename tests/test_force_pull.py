@@ -88,16 +88,22 @@ def test_a_pull_after_a_pull_off_ends_where_the_unpredicted_search_ends(name: st
     make, commands = HISTORIES[name]
     sim, new, new_trials = _run(_Counting, make(), commands)
     _, old, old_trials = _run(_Unpredicted, make(), commands)
+    _assert_the_same_steps(sim, new, old)
+    assert new_trials.sum() <= old_trials.sum()
+
+
+def _assert_the_same_steps(sim, new, old) -> None:
+    """Every step of `new` ends where the one of `old` does: the same contact state and
+    `unstable` flag, the force within the tolerance, the depth within ten times it. The
+    detachment is bisected to half the tolerance of the depth from another bracket: two such
+    ends lie within the width apart (and the steps after them as close)."""
     tolerance = sim.numerics.force_tolerance
     depth_scale = max(abs(o.depth) for o in old)
     for index, (a, b) in enumerate(zip(new, old, strict=True)):
         assert (a.contact_radius > 0.0) == (b.contact_radius > 0.0), (index, a, b)
         assert a.unstable == b.unstable, (index, a, b)
         assert abs(a.force - b.force) <= 2.0 * tolerance * max(abs(b.force), 1e-6 * 0.02), (index, a, b)
-        # The detachment is bisected to half the tolerance of the depth from another bracket:
-        # two such ends lie within the width apart (and the steps after them as close).
         assert abs(a.depth - b.depth) <= 10.0 * tolerance * depth_scale, (index, a.depth, b.depth)
-    assert new_trials.sum() <= old_trials.sum()
 
 
 def test_re_touch_rows_take_few_trials() -> None:
@@ -225,13 +231,7 @@ def test_the_aimed_detachment_ends_where_the_bisection_ends(name: str) -> None:
     make, commands = HISTORIES[name]
     sim, new, new_trials = _run(_Counting, make(), commands)
     _, old, old_trials = _run(_Bisected, make(), commands)
-    tolerance = sim.numerics.force_tolerance
-    depth_scale = max(abs(o.depth) for o in old)
-    for index, (a, b) in enumerate(zip(new, old, strict=True)):
-        assert (a.contact_radius > 0.0) == (b.contact_radius > 0.0), (index, a, b)
-        assert a.unstable == b.unstable, (index, a, b)
-        assert abs(a.force - b.force) <= 2.0 * tolerance * max(abs(b.force), 1e-6 * 0.02), (index, a, b)
-        assert abs(a.depth - b.depth) <= 10.0 * tolerance * depth_scale, (index, a.depth, b.depth)
+    _assert_the_same_steps(sim, new, old)
     assert new_trials.max() < old_trials.max(), (new_trials.max(), old_trials.max())
     assert new_trials.sum() < old_trials.sum()
 
