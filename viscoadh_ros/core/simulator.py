@@ -1556,6 +1556,13 @@ class ContactSimulator:
         # this one frame, the edge outputs read from the kernel's (`edge_height` and
         # `edge_gaps` return the same values after an advance): the general path's outputs and
         # state bit for bit, and its transaction (tests/test_step_lean.py).
+        if isinstance(time, float) and time == self._time and self._repeats(depth, force):
+            # The command the last step took, again at its instant (a message logged twice, a
+            # controller republishing): the step as it is. A second force search from the
+            # solved state could land elsewhere within the force tolerance (~1e-10 m), and a
+            # zero-time depth step searched the edge again (outside tester, 0.10.0; the
+            # kernel's `_advance_from` keeps the state for the batch path too).
+            return self._output
         if force is None and self._lean:
             if type(depth) is float and type(time) is float:
                 t, d = time, depth
@@ -1923,6 +1930,14 @@ class ContactSimulator:
             self._output, self._force_memo = before, memo
             raise
 
+    def _repeats(self, depth: Any, force: Any) -> bool:
+        """Whether (depth, force) is the command the last step took (at its instant: the
+        caller compares the times): the same depth under depth control, the same force under
+        force control; floats only (other types go the general path, which checks them)."""
+        if force is None:
+            return isinstance(depth, float) and self._held_force is None and depth == self._depth
+        return depth is None and isinstance(force, float) and force == self._held_force
+
     def _step_transaction(self, time: float, depth: float | None, force: float | None) -> StepOutput:
         """`step` on the general path: validation, then `_step` as a transaction."""
         saved = self._undo_token()
@@ -2066,6 +2081,21 @@ class ContactSimulator:
         )
         v_c1, v_c2 = physics.critical_speeds
         ok = (edge_speed == 0.0) | (np.abs(edge_speed) >= np.where(edge_speed > 0.0, v_c1, v_c2))
+        # A repeated sample (`step`'s `_repeats`: the same depth at the same instant after a
+        # depth step) publishes the step before it as it was; the kernel left the state alone.
+        repeated = (dt == 0.0) & (d == np.concatenate(([self._depth], d[:-1])))
+        repeated[0] &= self._held_force is None
+        if repeated.any():
+            rows = np.arange(t.size)
+            source = np.maximum.accumulate(np.where(repeated, -1, rows))
+            before = self._output
+            for values, first in (
+                (phase, int(before.phase)),
+                (edge_speed, before.edge_speed),
+                (effective, before.effective_work_of_adhesion),
+                (ok, before.scale_separation_ok),
+            ):
+                values[repeated] = np.where(source >= 0, values[np.maximum(source, 0)], first)[repeated]
         columns = {
             "time": t,
             "depth": d,
