@@ -15,12 +15,11 @@ from dataclasses import replace
 import mujoco
 import numpy as np
 import pytest
-import yaml
 
-from viscoadh_ros.core.config import SceneConfig
+from viscoadh_ros.core.config import SceneConfig, default_scene_path, read_yaml
 from viscoadh_ros.core.errors import ConfigError, InputError
 from viscoadh_ros.core.reference import hertz_force
-from viscoadh_ros.gripper.config import cell_from_dict, default_cell_path, load_cell
+from viscoadh_ros.gripper.config import GripperConfig, cell_from_dict, default_cell_path, load_cell
 from viscoadh_ros.gripper.cycle import run_cycle
 from viscoadh_ros.gripper.motion import Motion
 from viscoadh_ros.gripper.pads import LibraryPads, step_time
@@ -34,7 +33,7 @@ def cell():
 
 
 def raw_cell():
-    return yaml.safe_load(default_cell_path().read_text())
+    return read_yaml(default_cell_path())
 
 
 def test_adhesion_off_pad_resting_on_a_part_settles_at_the_hertz_depth():
@@ -169,6 +168,58 @@ def test_a_bad_gripper_key_is_one_clear_error(section, value, message):
     data["gripper"][section] = value
     with pytest.raises(ConfigError, match=message):
         cell_from_dict(data)
+
+
+@pytest.mark.parametrize(
+    ("written", "given"),
+    [
+        ("glass_shear_modulus: 3.0e+5", "glass_shear_modulus: 3.0e5"),
+        ("timestep: 2.0e-4 ", "timestep: 2e-4 "),
+    ],
+)
+def test_a_cell_file_reads_exponents_as_numbers_like_every_scene(tmp_path, written, given):
+    # 0.10.0's outside tester: plain yaml.safe_load read 3.0e5 and 2e-4 as strings ("must be a
+    # number (got '3.0e5')"), which every other verb, and ROS, read as numbers.
+    text = default_cell_path().read_text()
+    assert written in text
+    file = tmp_path / "cell.yaml"
+    file.write_text(text.replace(written, given))
+    loaded = load_cell(file)
+    assert loaded.pad.material.glass_shear_modulus == 3.0e5
+    assert loaded.gripper.timestep == 2.0e-4
+    assert loaded == load_cell(default_cell_path())
+
+
+def test_a_scene_without_a_gripper_section_is_refused_for_that(tmp_path):
+    # config/default.yaml is a valid scene with one sphere contact: it was refused for its
+    # number 1.0e6 (the wrong reason) and, read as a scene, would have run on gripper defaults.
+    with pytest.raises(ConfigError, match=r"default.yaml' has no 'gripper:' section"):
+        load_cell(default_scene_path())
+    result = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "viscoadh_ros",
+            "gripper",
+            "--cell",
+            str(default_scene_path()),
+            "--out",
+            str(tmp_path / "out"),
+        ],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    assert result.returncode == 2
+    (line,) = result.stderr.strip().splitlines()
+    assert line.startswith("viscoadh gripper: error: gripper file ") and "no 'gripper:' section" in line
+    assert not (tmp_path / "out").exists()
+
+
+def test_an_empty_gripper_section_takes_the_defaults():
+    data = raw_cell()
+    data["gripper"] = None
+    assert cell_from_dict(data).gripper == GripperConfig()
 
 
 def test_a_non_adhesive_pad_is_plotted_without_a_warning(tmp_path):
