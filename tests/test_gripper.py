@@ -261,6 +261,52 @@ def test_cli_bad_cell_is_one_line_and_exit_2(tmp_path):
     ]
 
 
+def test_every_scenario_is_checked_before_anything_runs_or_is_written(tmp_path, monkeypatch, capsys):
+    # 0.10.0's outside tester: 2x2 pads at 1.5e-4 s passed 'pick' (a 1.3 g part), which ran,
+    # wrote its figure and printed its outcomes, then 'transport' (1 g) was refused: exit 2
+    # after writing, where docs/cli.md says exit 2 writes nothing. No run may start now.
+    import re
+
+    from viscoadh_ros.cli.main import main
+    from viscoadh_ros.gripper import scenarios
+
+    def no_run(*args, **kwargs):
+        raise AssertionError("a scenario ran before every scenario was checked")
+
+    monkeypatch.setattr(scenarios, "run_cycle", no_run)
+    file = tmp_path / "cell_15.yaml"
+    file.write_text(default_cell_path().read_text().replace("timestep: 2.0e-4", "timestep: 1.5e-4"))
+    out = tmp_path / "out"
+    assert main(["gripper", "--cell", str(file), "--pads", "2x2", "--out", str(out)]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == "" and not out.exists()
+    (line,) = captured.err.strip().splitlines()
+    assert line.startswith(
+        "viscoadh gripper: error: scenario transport (lift at 2 m/s^2): gripper.timestep 0.00015 s "
+        "is too long for a 1 g part on 4 pad(s)"
+    ), line
+    # The step it suggests for all the refused runs is accepted by every scenario.
+    suggested = float(re.search(r"gripper.timestep <= ([0-9.e-]+) s suits every one", line).group(1))
+    cell = load_cell(file)
+    cell = replace(cell, gripper=replace(cell.gripper.with_pads(2, 2), timestep=suggested))
+    scenarios.check({name: scenarios.plan(name, cell) for name in scenarios.SCENARIOS})
+
+
+def test_run_labels_state_the_setting_not_the_expected_outcome(cell, monkeypatch):
+    # The same tester: with 2x2 pads the pick printed "press 150 um, no hold (too short):
+    # picked and held"; the label said what the built-in cell's single pad gives.
+    from viscoadh_ros.gripper import scenarios
+
+    monkeypatch.setattr(scenarios, "run_cycle", lambda cell, motion, pads, **kwargs: motion)
+    runs = scenarios.scenario_pick(cell, scenarios.library_bank)
+    assert [run.label for run in runs] == [
+        "press 150 um, no hold",
+        "press 10 um, hold 0.3 s",
+        "press 150 um, hold 0.3 s",
+    ]
+    assert [run.label for run in runs] == [scenarios.grip_text(run.trajectory) for run in runs]
+
+
 def test_motion_rejects_a_negative_hold():
     with pytest.raises(InputError, match="hold_time must be a finite number >= 0"):
         Motion(hold_time=-1.0).validated()
