@@ -15,12 +15,11 @@ from dataclasses import replace
 import mujoco
 import numpy as np
 import pytest
-import yaml
 
-from viscoadh_ros.core.config import SceneConfig
+from viscoadh_ros.core.config import SceneConfig, default_scene_path, read_yaml
 from viscoadh_ros.core.errors import ConfigError, InputError
 from viscoadh_ros.core.reference import hertz_force
-from viscoadh_ros.gripper.config import cell_from_dict, default_cell_path, load_cell
+from viscoadh_ros.gripper.config import GripperConfig, cell_from_dict, default_cell_path, load_cell
 from viscoadh_ros.gripper.cycle import run_cycle
 from viscoadh_ros.gripper.motion import Motion
 from viscoadh_ros.gripper.pads import LibraryPads, step_time
@@ -34,7 +33,7 @@ def cell():
 
 
 def raw_cell():
-    return yaml.safe_load(default_cell_path().read_text())
+    return read_yaml(default_cell_path())
 
 
 def test_adhesion_off_pad_resting_on_a_part_settles_at_the_hertz_depth():
@@ -171,6 +170,58 @@ def test_a_bad_gripper_key_is_one_clear_error(section, value, message):
         cell_from_dict(data)
 
 
+@pytest.mark.parametrize(
+    ("written", "given"),
+    [
+        ("glass_shear_modulus: 3.0e+5", "glass_shear_modulus: 3.0e5"),
+        ("timestep: 2.0e-4 ", "timestep: 2e-4 "),
+    ],
+)
+def test_a_cell_file_reads_exponents_as_numbers_like_every_scene(tmp_path, written, given):
+    # 0.10.0's outside tester: plain yaml.safe_load read 3.0e5 and 2e-4 as strings ("must be a
+    # number (got '3.0e5')"), which every other verb, and ROS, read as numbers.
+    text = default_cell_path().read_text()
+    assert written in text
+    file = tmp_path / "cell.yaml"
+    file.write_text(text.replace(written, given))
+    loaded = load_cell(file)
+    assert loaded.pad.material.glass_shear_modulus == 3.0e5
+    assert loaded.gripper.timestep == 2.0e-4
+    assert loaded == load_cell(default_cell_path())
+
+
+def test_a_scene_without_a_gripper_section_is_refused_for_that(tmp_path):
+    # config/default.yaml is a valid scene with one sphere contact: it was refused for its
+    # number 1.0e6 (the wrong reason) and, read as a scene, would have run on gripper defaults.
+    with pytest.raises(ConfigError, match=r"default.yaml' has no 'gripper:' section"):
+        load_cell(default_scene_path())
+    result = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "viscoadh_ros",
+            "gripper",
+            "--cell",
+            str(default_scene_path()),
+            "--out",
+            str(tmp_path / "out"),
+        ],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    assert result.returncode == 2
+    (line,) = result.stderr.strip().splitlines()
+    assert line.startswith("viscoadh gripper: error: gripper file ") and "no 'gripper:' section" in line
+    assert not (tmp_path / "out").exists()
+
+
+def test_an_empty_gripper_section_takes_the_defaults():
+    data = raw_cell()
+    data["gripper"] = None
+    assert cell_from_dict(data).gripper == GripperConfig()
+
+
 def test_a_non_adhesive_pad_is_plotted_without_a_warning(tmp_path):
     # Without adhesion the pads never pull: the force axis was limited to (0, 0), which
     # matplotlib warns about (an outside tester, 0.9.0).
@@ -208,6 +259,52 @@ def test_cli_bad_cell_is_one_line_and_exit_2(tmp_path):
     assert result.stderr.strip().splitlines() == [
         "viscoadh gripper: error: gripper.arm.stifness: unknown key (did you mean 'stiffness'?)"
     ]
+
+
+def test_every_scenario_is_checked_before_anything_runs_or_is_written(tmp_path, monkeypatch, capsys):
+    # 0.10.0's outside tester: 2x2 pads at 1.5e-4 s passed 'pick' (a 1.3 g part), which ran,
+    # wrote its figure and printed its outcomes, then 'transport' (1 g) was refused: exit 2
+    # after writing, where docs/cli.md says exit 2 writes nothing. No run may start now.
+    import re
+
+    from viscoadh_ros.cli.main import main
+    from viscoadh_ros.gripper import scenarios
+
+    def no_run(*args, **kwargs):
+        raise AssertionError("a scenario ran before every scenario was checked")
+
+    monkeypatch.setattr(scenarios, "run_cycle", no_run)
+    file = tmp_path / "cell_15.yaml"
+    file.write_text(default_cell_path().read_text().replace("timestep: 2.0e-4", "timestep: 1.5e-4"))
+    out = tmp_path / "out"
+    assert main(["gripper", "--cell", str(file), "--pads", "2x2", "--out", str(out)]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == "" and not out.exists()
+    (line,) = captured.err.strip().splitlines()
+    assert line.startswith(
+        "viscoadh gripper: error: scenario transport (lift at 2 m/s^2): gripper.timestep 0.00015 s "
+        "is too long for a 1 g part on 4 pad(s)"
+    ), line
+    # The step it suggests for all the refused runs is accepted by every scenario.
+    suggested = float(re.search(r"gripper.timestep <= ([0-9.e-]+) s suits every one", line).group(1))
+    cell = load_cell(file)
+    cell = replace(cell, gripper=replace(cell.gripper.with_pads(2, 2), timestep=suggested))
+    scenarios.check({name: scenarios.plan(name, cell) for name in scenarios.SCENARIOS})
+
+
+def test_run_labels_state_the_setting_not_the_expected_outcome(cell, monkeypatch):
+    # The same tester: with 2x2 pads the pick printed "press 150 um, no hold (too short):
+    # picked and held"; the label said what the built-in cell's single pad gives.
+    from viscoadh_ros.gripper import scenarios
+
+    monkeypatch.setattr(scenarios, "run_cycle", lambda cell, motion, pads, **kwargs: motion)
+    runs = scenarios.scenario_pick(cell, scenarios.library_bank)
+    assert [run.label for run in runs] == [
+        "press 150 um, no hold",
+        "press 10 um, hold 0.3 s",
+        "press 150 um, hold 0.3 s",
+    ]
+    assert [run.label for run in runs] == [scenarios.grip_text(run.trajectory) for run in runs]
 
 
 def test_motion_rejects_a_negative_hold():

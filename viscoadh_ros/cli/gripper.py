@@ -72,7 +72,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def main(args: argparse.Namespace) -> int:
-    """Run the scenarios, write one PNG each, print the outcomes; 2 for bad input."""
+    """Run the scenarios, write one PNG each, print the outcomes; 2 for bad input (every
+    scenario is planned and checked first: then nothing is written)."""
     import os
     import re
     from dataclasses import replace
@@ -105,7 +106,7 @@ def main(args: argparse.Namespace) -> int:
     from viscoadh_ros.gripper import render, scenarios
     from viscoadh_ros.gripper.config import default_cell_path, load_cell
     from viscoadh_ros.gripper.figures import plot_runs, plot_weights
-    from viscoadh_ros.gripper.scenarios import RUNNERS, library_bank
+    from viscoadh_ros.gripper.scenarios import library_bank
 
     path = args.cell if args.cell is not None else default_cell_path()
     if not path.is_file():
@@ -119,8 +120,12 @@ def main(args: argparse.Namespace) -> int:
         from viscoadh_ros.gripper.node_loop import NodePads
 
         bank = NodePads
-    args.out.mkdir(parents=True, exist_ok=True)
     names = SCENARIO_NAMES if args.scenario == "all" else (args.scenario,)
+    # Every scenario planned and checked before anything is written or run: exit 2 means
+    # nothing written (docs/cli.md), also when a later scenario's run would be refused.
+    planned = {name: scenarios.plan(name, cell) for name in names}
+    scenarios.check(planned)
+    args.out.mkdir(parents=True, exist_ok=True)
     scenario_name = ""
     if args.frames is not None:
 
@@ -136,7 +141,7 @@ def main(args: argparse.Namespace) -> int:
         scenario_name = name
         started = time.perf_counter()
         try:
-            runs = RUNNERS[name](cell, bank)
+            runs = [scenarios.run_planned(run, bank) for run in planned[name]]
         finally:
             for recording in recorders:
                 recording.close()

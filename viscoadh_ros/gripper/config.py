@@ -28,9 +28,7 @@ from dataclasses import dataclass, fields, replace
 from pathlib import Path
 from typing import Any
 
-import yaml
-
-from viscoadh_ros.core.config import ContactConfig, SceneConfig
+from viscoadh_ros.core.config import ContactConfig, SceneConfig, read_yaml
 from viscoadh_ros.core.errors import ConfigError
 
 #: Top-level key of the cell section in a gripper file.
@@ -244,21 +242,28 @@ def check_layout(config: GripperConfig) -> GripperConfig:
 
 def load_cell(path: str | Path) -> Cell:
     """Load a gripper file: its scene (exactly one contact, a sphere: the pad) through
-    core/config.py, its ``gripper`` section here. ConfigError naming the bad key."""
+    core/config.py, its ``gripper`` section here. ConfigError naming the bad key.
+
+    The file is read by the scene loader (`read_yaml`, as ROS 2 reads params files), so
+    ``3.0e5`` and ``2e-4`` are numbers here as in every other scene (0.10.0's outside tester:
+    plain ``yaml.safe_load`` read them as strings and refused them as "not a number")."""
     file = Path(path)
-    try:
-        data = yaml.safe_load(file.read_text(encoding="utf-8"))
-    except OSError as error:
-        raise ConfigError(f"cannot read gripper file {str(file)!r}: {error.strerror}") from None
-    except yaml.YAMLError as error:
-        raise ConfigError(f"gripper file {str(file)!r} is not valid YAML: {error}") from None
-    return cell_from_dict(data)
+    return cell_from_dict(read_yaml(file, what="gripper file"), source=f"gripper file {str(file)!r}")
 
 
-def cell_from_dict(data: Any) -> Cell:
-    """The Cell of a gripper file's mapping (see the module docstring)."""
+def cell_from_dict(data: Any, *, source: str = "the gripper mapping") -> Cell:
+    """The Cell of a gripper file's mapping (see the module docstring); ``source`` names it
+    in the error of a missing ``gripper`` section."""
     if not isinstance(data, Mapping):
         raise ConfigError("a gripper file must hold a mapping (the scene plus a 'gripper' section)")
+    if SECTION not in data:
+        # Checked before the scene: a plain scene (config/default.yaml) is a valid scene, so
+        # without this it ran on every gripper default (or failed on a scene key instead).
+        raise ConfigError(
+            f"{source} has no '{SECTION}:' section: a gripper file is a scene with one pad "
+            f"contact plus a '{SECTION}:' section (every key in it optional; '{SECTION}: {{}}' "
+            "takes the defaults; see docs/gripper.md)"
+        )
     scene_part = {k: v for k, v in data.items() if k != SECTION}
     scene = SceneConfig.from_dict(scene_part)
     if len(scene.contacts) != 1:

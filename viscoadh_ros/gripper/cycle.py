@@ -57,18 +57,34 @@ def stability_number(cell: Cell, depth: float) -> float:
     return omega * g.timestep
 
 
+def _deepest(motion: Motion) -> float:
+    return max(motion.press_depth, motion.place_depth if motion.place else 0.0)
+
+
+def longest_stable_timestep(cell: Cell, motion: Motion) -> float:
+    """The longest ``gripper.timestep`` (s) `check_stability` accepts for ``motion``."""
+    return cell.gripper.timestep * STABILITY_LIMIT / stability_number(cell, _deepest(motion))
+
+
+def timestep_text(seconds: float) -> str:
+    """``seconds`` rounded DOWN to 3 significant digits, as text: a time step suggested as
+    ``<= 0.000146 s`` is then accepted (``:.3g`` alone may round above the bound)."""
+    scale = 10.0 ** (math.floor(math.log10(seconds)) - 2)
+    return f"{math.floor(seconds / scale) * scale:.3g}"
+
+
 def check_stability(cell: Cell, motion: Motion) -> None:
     """InputError (with the longest stable time step) when the explicit coupling would not
     resolve the pads-on-part oscillation at the motion's deepest press."""
-    depth = max(motion.press_depth, motion.place_depth if motion.place else 0.0)
+    depth = _deepest(motion)
     number = stability_number(cell, depth)
     if number > STABILITY_LIMIT:
-        longest = cell.gripper.timestep * STABILITY_LIMIT / number
+        longest = longest_stable_timestep(cell, motion)
         raise InputError(
             f"gripper.timestep {cell.gripper.timestep:g} s is too long for a "
             f"{cell.gripper.part.mass * 1e3:g} g part on {cell.gripper.pad_count} pad(s) pressed "
             f"{depth * 1e6:g} um: omega*dt = {number:.2f} > {STABILITY_LIMIT} "
-            f"(use gripper.timestep <= {longest:.3g} s, a heavier part or a shallower press)"
+            f"(use gripper.timestep <= {timestep_text(longest)} s, a heavier part or a shallower press)"
         )
 
 
