@@ -301,6 +301,8 @@ def load_experiment(
     events_topic, restarts = None, ()
     # What the node had counted before the record (a record that starts mid-history).
     counts = _state_counts(bag, inputs) if bag.topics[inputs] == COMMAND else None
+    if by_arrival and counts is not None:
+        _refuse_broken_sequence(bag, inputs, order, counts)
     earlier, shown_by = _commands_before(counts, order)
     rejected_before = 0
     if by_arrival:
@@ -451,6 +453,46 @@ def _commands_before(counts: _StateCounts | None, order: NDArray[np.int64]) -> t
     ahead = counts.received + counts.rejected - logged
     state = int(np.argmin(ahead))
     return max(int(ahead[state]), 0), state
+
+
+def _refuse_broken_sequence(bag: Bag, inputs: str, order: NDArray[np.int64], counts: _StateCounts) -> None:
+    """An InputError naming the file when the files of a log (several files, written by our
+    recorder) do not hold one history of the contact in order: each ContactState counts the
+    commands the node received since it started, so the commands counted and not recorded
+    before it (`_commands_before`) are the same in every file of one log. More in a later
+    file: a file between is missing (or its recorder dropped commands); fewer: a file is
+    repeated (a copy), or comes from another run of the node (its counters start again at 1).
+    An outside tester's folders (a rotated log with file 7 left out, a copy of file 1, two
+    sessions' logs) replayed with exit 0 and wrong forces. A recording by another recorder
+    (``ros2 bag``) may take a state before the command it answers, so it is not checked."""
+    if len(bag.files) < 2 or bag.software_version is None:
+        return
+    logged = np.searchsorted(np.sort(order), counts.order)
+    ahead = counts.received + counts.rejected - logged
+    files = np.searchsorted(np.asarray(bag.file_starts), counts.order, side="right") - 1
+    contact = inputs.strip("/").split("/")[-2] if inputs.strip("/").count("/") else inputs
+    last: tuple[int, int] | None = None
+    for file in np.unique(files).tolist():
+        here = int(ahead[files == file].min())
+        if last is not None and here != last[1]:
+            name, before = bag.files[file].name, bag.files[last[0]].name
+            if here > last[1]:
+                what = (
+                    f"count {here - last[1]} commands on {inputs!r} that the files before it do not hold: "
+                    f"a file between {before} and {name} is missing (or the recorder dropped commands)"
+                )
+            else:
+                what = (
+                    f"count {last[1] - here} fewer commands on {inputs!r} than the files before it hold: "
+                    f"{name} repeats an earlier file (a copy) or comes from another run of the node "
+                    "(whose counters start again at 1)"
+                )
+            raise InputError(
+                f"contact {contact!r}: {str(bag.path)!r} is not one history of the contact: the "
+                f"ContactState counters in {name} {what}; replay the files of one run of the node, "
+                "all of them, in one folder"
+            )
+        last = (file, here)
 
 
 def _refuse_mid_history(
