@@ -162,7 +162,7 @@ def _numbered_files(folder: Path, files: list[Path]) -> list[Path]:
     if len(stems) > 1:
         logs = ", ".join(f"{stem}_*.mcap ({len(numbered)} files)" for stem, numbered in sorted(stems.items()))
         raise InputError(f"{where} holds the files of several logs: {logs}; {advice}")
-    (stem, numbered), = stems.items()
+    ((stem, numbered),) = stems.items()
     numbered.sort(key=lambda item: item[0])
     numbers = [n for n, _ in numbered]
     repeated = sorted({n for n in numbers if numbers.count(n) > 1})
