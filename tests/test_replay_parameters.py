@@ -209,3 +209,35 @@ def test_a_fit_after_the_change_with_a_scene_holds_what_the_change_set(log: Path
     assert done.changed_at is not None
     assert done.result.contact.adhesion.work_of_adhesion == 0.2
     assert done.result.values["G0"] == pytest.approx(1.0e6, rel=1e-2), done.result.values
+
+
+def test_plot_draws_the_reference_of_the_scene_in_force(
+    log: Path, tmp_path: Path, capsys: Any, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """`viscoadh plot` of the whole log (a change in it) and of its last file (recorded after
+    the change): the reference is the w = 0.2 contact's, and a change in the record is said;
+    the loops break at the change (no line from one material's history into the other's)."""
+    from viscoadh_ros.cli import plot
+    from viscoadh_ros.plotting import JkrReference
+
+    drawn: list[float] = []
+    original = JkrReference.from_contact
+
+    def spy(contact: Any) -> Any:
+        drawn.append(contact.adhesion.work_of_adhesion)
+        return original(contact)
+
+    monkeypatch.setattr(JkrReference, "from_contact", spy)
+    last = max(log.glob("session_*.mcap"), key=lambda f: int(f.stem.split("_")[1]))
+    assert main(["plot", str(last), "-o", str(tmp_path / "last.png")]) == 0
+    assert drawn == [0.2] and "note" not in capsys.readouterr().out
+    assert main(["plot", str(log), "-o", str(tmp_path / "whole.png")]) == 0
+    printed = capsys.readouterr().out
+    assert drawn == [0.2, 0.2], drawn
+    assert "parameters change in the record (1 PARAMETERS event(s))" in printed and "at its end" in printed
+    assert (tmp_path / "whole.png").stat().st_size > 0
+
+    import argparse
+
+    curves, _, _ = plot._mcap_curves(argparse.Namespace(input=log, recover=False, contact=None))
+    assert int(np.count_nonzero(np.isnan(curves[0].depth))) == 1, "one break, at the change"
