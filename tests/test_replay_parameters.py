@@ -241,3 +241,34 @@ def test_plot_draws_the_reference_of_the_scene_in_force(
 
     curves, _, _ = plot._mcap_curves(argparse.Namespace(input=log, recover=False, contact=None))
     assert int(np.count_nonzero(np.isnan(curves[0].depth))) == 1, "one break, at the change"
+
+
+def test_a_reader_that_stops_early_ends_the_cli_quietly(log: Path, tmp_path: Path) -> None:
+    """`viscoadh replay ... | head` ended in a BrokenPipeError traceback: now exit 141 (as
+    SIGPIPE), nothing on stderr, and the outputs written before the summary is printed."""
+    import os
+    import subprocess
+    import sys
+
+    import viscoadh_ros
+
+    root = str(Path(viscoadh_ros.__file__).resolve().parents[1])
+    out, summary = tmp_path / "out.mcap", tmp_path / "summary.json"
+    command = [
+        sys.executable,
+        "-m",
+        "viscoadh_ros",
+        "replay",
+        str(log),
+        "-o",
+        str(out),
+        "--json",
+        str(summary),
+    ]
+    env = {**os.environ, "PYTHONPATH": root}
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=env)
+    process.stdout.close()  # the reader is gone before the summary is printed
+    _, err = process.communicate(timeout=120)
+    assert process.returncode == 141, err.decode()
+    assert err.decode() == ""
+    assert out.stat().st_size > 0 and json.loads(summary.read_text())["max_error_N"] == 0.0

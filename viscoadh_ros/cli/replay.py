@@ -203,6 +203,10 @@ def main(args: argparse.Namespace) -> int:
     result, experiment = replay_one(args, progress=True)
     skipped = experiment.rejected_index.size
     stretches = result.pop("_materials")
+    # Every file written before the summary is printed: a reader that stops early (`| head`)
+    # loses only the text.
+    if args.json is not None:
+        args.json.write_text(json.dumps(result, indent=2) + "\n", encoding="utf-8")
     print(
         f"replayed {experiment.input_ns.size} inputs of {result['contact']} over "
         f"{experiment.duration:.3f} s at {result['replay_speed_x_real_time']:.3g}x real time"
@@ -215,8 +219,6 @@ def main(args: argparse.Namespace) -> int:
         f"model {_pull_off_text(result['model_pull_off_force_N'])}\n"
         f"wrote {args.output}"
     )
-    if args.json is not None:
-        args.json.write_text(json.dumps(result, indent=2) + "\n", encoding="utf-8")
     return 0
 
 
