@@ -250,3 +250,33 @@ def test_sigkill_leaves_complete_chunks_readable(tmp_path: Path) -> None:
     # Every complete chunk survives (about 25 messages fit a 1 kB chunk); the open one is lost.
     assert values == [float(i) for i in range(len(values))]
     assert 1000 - 50 <= len(values) < 1000, f"recovered {len(values)} of 1000"
+
+
+@pytest.mark.parametrize("path", ["rot.mcap", "rot"], ids=["file", "folder"])
+def test_rotated_files_name_the_scene_in_force_when_they_start(tmp_path: Path, path: str) -> None:
+    """After `set_scene` (the node's runtime parameter change) the files started later store
+    the new scene; the file open at the change keeps the one it started with (an outside
+    tester's files recorded entirely after a change to w = 0.2 stored w = 0.05, and `viscoadh
+    plot` drew the w = 0.05 reference over them). The log as a whole starts with the first."""
+    changed = {"/**": {"ros__parameters": {"contacts": ["finger"], "changed": True}}}
+    with McapRecorder(tmp_path / path, scene=SCENE, max_duration=1.0) as rec:
+        for i in range(200):
+            if i == 70:  # 2.225 s: in the second file (2.015 s .. ), the third starts at 3.03 s
+                rec.set_scene(changed)
+            rec.record("/depth", Float64(data=float(i)), 1_000_000_000 + i * 17_500_000)
+    files = rec.paths
+    assert len(files) == 4, files
+    assert [Bag(f).scene() for f in files] == [SCENE, SCENE, changed, changed]
+    whole = Bag(files[0].parent if path == "rot" else _together(tmp_path, files))
+    assert whole.scene() == SCENE and whole.scene(3) == changed
+    if path == "rot":
+        info = yaml.safe_load((tmp_path / path / "metadata.yaml").read_text())["rosbag2_bagfile_information"]
+        assert yaml.safe_load(info["custom_data"][mcap_log.SCENE_KEY]) == SCENE
+
+
+def _together(tmp_path: Path, files: list[Path]) -> Path:
+    folder = tmp_path / "together"
+    folder.mkdir()
+    for file in files:
+        (folder / file.name).write_bytes(file.read_bytes())
+    return folder

@@ -194,7 +194,11 @@ def test_replay_of_node_log_reproduces_its_forces(node_run: NodeRun, tmp_path: P
         "resets",
         "parameter_changes",
         "restarts",
+        "materials",
     }
+    # One stretch, one material: the record's own (no parameter change), no line printed.
+    assert summary["materials"] == [{"from_s": 0.0, "changed": {}, "replaced": {}}]
+    assert "material t =" not in printed
     assert summary["contact"] == "finger" and summary["force_topic"] == "/finger/wrench"
     logged = Bag(node_run.log)
     assert summary["samples"] == logged.message_count("/finger/wrench")

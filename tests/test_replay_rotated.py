@@ -201,3 +201,66 @@ def test_the_whole_log_replays_exactly(rotated: tuple[str, list[Path]], tmp_path
         peak = max(_peak(f, contact) for f in files)
         assert summary["max_error_N"] <= 1e-9 * peak, summary
         assert summary["commands_rejected"] == (3 if contact == "c0" else 0), summary
+
+
+def _folder(tmp_path: Path, name: str, files: dict[str, Path]) -> Path:
+    """A folder (no metadata.yaml) holding ``files`` under the names given."""
+    folder = tmp_path / name
+    folder.mkdir()
+    for target, source in files.items():
+        shutil.copy(source, folder / target)
+    return folder
+
+
+def _refused(bag: Path, tmp_path: Path, capsys: Any) -> str:
+    """The one-line error of replaying (and fitting) ``bag``, which must be refused."""
+    for contact in CONTACTS:
+        code, _ = _replay(bag, contact, tmp_path)
+        err = capsys.readouterr().err
+        assert code == 2, (contact, err)
+        assert len(err.strip().splitlines()) == 1, err
+        assert not (tmp_path / f"{bag.stem}_{contact}.mcap").exists()
+    fit = ["fit", str(bag), "--contact", "c1", "--free", "work_of_adhesion", "--no-report"]
+    assert main([*fit, "-o", str(tmp_path / "fit.yaml")]) == 2
+    assert not (tmp_path / "fit.yaml").exists()
+    assert capsys.readouterr().err == err.replace("viscoadh replay:", "viscoadh fit:", 1)
+    return err
+
+
+def test_a_folder_with_a_file_missing_is_refused(
+    rotated: tuple[str, list[Path]], tmp_path: Path, capsys: Any
+) -> None:
+    """An outside tester's rotated log with one file left out replayed with exit 0 and a
+    model pull-off of -13.9 mN against the node's -31.5 mN."""
+    _, files = rotated
+    gap = _folder(tmp_path, "gap", {"session_0.mcap": files[0], "session_2.mcap": files[2]})
+    err = _refused(gap, tmp_path, capsys)
+    assert "lacks session_1.mcap" in err and "no metadata.yaml" in err, err
+    # The same with the files renumbered: the counters in the later file show the commands
+    # missing.
+    renamed = _folder(tmp_path, "renamed", {"session_0.mcap": files[0], "session_1.mcap": files[2]})
+    err = _refused(renamed, tmp_path, capsys)
+    assert "not one history of the contact" in err and "ContactState counters in session_1.mcap" in err, err
+    assert "missing" in err, err
+
+
+def test_a_folder_with_a_repeated_file_or_another_run_is_refused(
+    rotated: tuple[str, list[Path]], tmp_path: Path, capsys: Any
+) -> None:
+    """A copy of file 1 beside the log, and two logs in one folder, replayed with exit 0 (the
+    tester's run: "skipped 63 the node rejected", though the node rejected none)."""
+    _, files = rotated
+    whole = {f.name: f for f in files}
+    copy = _folder(tmp_path, "copy", {**whole, "session_1_copy.mcap": files[1]})
+    err = _refused(copy, tmp_path, capsys)
+    assert "session_1_copy.mcap is not numbered" in err, err
+    two = _folder(tmp_path, "two", {**whole, **{f"other_{k}.mcap": f for k, f in enumerate(files)}})
+    err = _refused(two, tmp_path, capsys)
+    assert "several logs" in err and "other_*.mcap (3 files)" in err and "session_*.mcap" in err, err
+    # Named as the log's next file: the counters say what it is. A copy of file 1, and the
+    # start of another run of the node (file 0 again: its counters start at 1).
+    for label, source in (("repeat", files[1]), ("restart", files[0])):
+        extra = _folder(tmp_path, label, {**whole, "session_3.mcap": source})
+        err = _refused(extra, tmp_path, capsys)
+        assert "ContactState counters in session_3.mcap" in err and "fewer commands" in err, err
+        assert "another run of the node" in err, err

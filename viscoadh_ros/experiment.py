@@ -301,6 +301,8 @@ def load_experiment(
     events_topic, restarts = None, ()
     # What the node had counted before the record (a record that starts mid-history).
     counts = _state_counts(bag, inputs) if bag.topics[inputs] == COMMAND else None
+    if by_arrival and counts is not None:
+        _refuse_broken_sequence(bag, inputs, order, counts)
     earlier, shown_by = _commands_before(counts, order)
     rejected_before = 0
     if by_arrival:
@@ -451,6 +453,46 @@ def _commands_before(counts: _StateCounts | None, order: NDArray[np.int64]) -> t
     ahead = counts.received + counts.rejected - logged
     state = int(np.argmin(ahead))
     return max(int(ahead[state]), 0), state
+
+
+def _refuse_broken_sequence(bag: Bag, inputs: str, order: NDArray[np.int64], counts: _StateCounts) -> None:
+    """An InputError naming the file when the files of a log (several files, written by our
+    recorder) do not hold one history of the contact in order: each ContactState counts the
+    commands the node received since it started, so the commands counted and not recorded
+    before it (`_commands_before`) are the same in every file of one log. More in a later
+    file: a file between is missing (or its recorder dropped commands); fewer: a file is
+    repeated (a copy), or comes from another run of the node (its counters start again at 1).
+    An outside tester's folders (a rotated log with file 7 left out, a copy of file 1, two
+    sessions' logs) replayed with exit 0 and wrong forces. A recording by another recorder
+    (``ros2 bag``) may take a state before the command it answers, so it is not checked."""
+    if len(bag.files) < 2 or bag.software_version is None:
+        return
+    logged = np.searchsorted(np.sort(order), counts.order)
+    ahead = counts.received + counts.rejected - logged
+    files = np.searchsorted(np.asarray(bag.file_starts), counts.order, side="right") - 1
+    contact = inputs.strip("/").split("/")[-2] if inputs.strip("/").count("/") else inputs
+    last: tuple[int, int] | None = None
+    for file in np.unique(files).tolist():
+        here = int(ahead[files == file].min())
+        if last is not None and here != last[1]:
+            name, before = bag.files[file].name, bag.files[last[0]].name
+            if here > last[1]:
+                what = (
+                    f"count {here - last[1]} commands on {inputs!r} that the files before it do not hold: "
+                    f"a file between {before} and {name} is missing (or the recorder dropped commands)"
+                )
+            else:
+                what = (
+                    f"count {last[1] - here} fewer commands on {inputs!r} than the files before it hold: "
+                    f"{name} repeats an earlier file (a copy) or comes from another run of the node "
+                    "(whose counters start again at 1)"
+                )
+            raise InputError(
+                f"contact {contact!r}: {str(bag.path)!r} is not one history of the contact: the "
+                f"ContactState counters in {name} {what}; replay the files of one run of the node, "
+                "all of them, in one folder"
+            )
+        last = (file, here)
 
 
 def _refuse_mid_history(
@@ -717,12 +759,122 @@ def changed_contact(restart: Restart, contact_id: str) -> ContactConfig:
     return scene.contact(contact_id)
 
 
+@dataclass(frozen=True)
+class Material:
+    """The contact a stretch of a record runs with: from the record's start (``ns`` None) or
+    from a PARAMETERS event (its stamp ``ns``), with what that event changed."""
+
+    contact: ContactConfig
+    ns: int | None = None
+    #: The parameters the logged change set (relative keys, ``"adhesion.work_of_adhesion"``):
+    #: ``(before, after)`` as the node ran them.
+    changed: dict[str, tuple[Any, Any]] = field(default_factory=dict)
+    #: Of those, the values the user's scene held that the change replaced where they differed
+    #: from the node's before the change.
+    replaced: dict[str, Any] = field(default_factory=dict)
+    given: bool = False  # True: the change applied to the user's scene; False: the node's contact
+
+    def describe(self, experiment: Experiment, start: str) -> str:
+        """``t = 4.07 s on: <what>``; ``start``: what the record starts with."""
+        at = 0.0 if self.ns is None else float(experiment.time(np.array([self.ns]))[0])
+        if self.ns is None:
+            return f"t = {at:.6g} s on: {start}"
+        change = ", ".join(f"{k} {_value_text(a)} -> {_value_text(b)}" for k, (a, b) in self.changed.items())
+        change = f"the logged parameter change {change or '(nothing of this contact)'}"
+        text = f"t = {at:.6g} s on: " + (
+            f"{change} applied to the --scene contact" if self.given else f"the node's contact after {change}"
+        )
+        if self.replaced:
+            text += (
+                " (replacing the scene's "
+                + ", ".join(f"{k} {_value_text(v)}" for k, v in self.replaced.items())
+                + ")"
+            )
+        return text
+
+    def as_dict(self, experiment: Experiment) -> dict[str, Any]:
+        """JSON-ready: ``from_s``, ``changed`` ``{key: [before, after]}``, ``replaced``."""
+        at = 0.0 if self.ns is None else float(experiment.time(np.array([self.ns]))[0])
+        return {
+            "from_s": at,
+            "changed": {k: [a, b] for k, (a, b) in self.changed.items()},
+            "replaced": dict(self.replaced),
+        }
+
+
+def _value_text(value: Any) -> str:
+    if isinstance(value, float):
+        return f"{value:g}"
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(_value_text(v) for v in value) + "]"
+    return str(value)
+
+
+def _contact_parameters(contact: ContactConfig) -> dict[str, Any]:
+    """The contact's parameters with keys relative to it (``"adhesion.work_of_adhesion"``)."""
+    from viscoadh_ros.core.config import SceneConfig
+
+    prefix = contact.id + "."
+    flat = SceneConfig(contacts=(contact,)).to_parameters()
+    return {k[len(prefix) :]: v for k, v in flat.items() if k.startswith(prefix)}
+
+
+def materials(
+    experiment: Experiment, contact: ContactConfig, *, logged: ContactConfig | None, given: bool
+) -> list[Material]:
+    """The contact each stretch of ``experiment`` runs with: ``contact`` from the start, then
+    one per PARAMETERS event, in order.
+
+    ``given`` False (``contact`` is the log's own): each event's contact as logged, the node's.
+    ``given`` True (a scene the user gave, e.g. a candidate material): the parameters the
+    event changed (its contact against the node's before it: ``logged``, the contact the log
+    stores for its start, for the first event, the previous event's for the others) are set
+    on the user's contact, everything else stays the user's; a log that stores no scene has
+    ``contact`` stand for the node's start (``logged`` None). InputError when a change cannot
+    apply to the user's contact (say, a Kelvin chain of another length)."""
+    from viscoadh_ros.core.config import SceneConfig
+    from viscoadh_ros.core.errors import ConfigError
+
+    found = [Material(contact)]
+    node_before = logged if logged is not None else contact
+    current = contact
+    for restart in experiment.restarts:
+        if restart.kind != PARAMETERS:
+            continue
+        node_after = changed_contact(restart, contact.id)
+        old, new = _contact_parameters(node_before), _contact_parameters(node_after)
+        changed = {k: (old.get(k), v) for k, v in new.items() if old.get(k) != v}
+        removed = [k for k in old if k not in new]
+        if not given:
+            current = dataclasses.replace(node_after, id=contact.id)
+            replaced: dict[str, Any] = {}
+        else:
+            mine = _contact_parameters(current)
+            replaced = {k: mine[k] for k in changed if k in mine and mine[k] != old.get(k)}
+            updated = {k: v for k, v in mine.items() if k not in removed}
+            updated.update({k: after for k, (_, after) in changed.items()})
+            try:
+                current = SceneConfig.from_parameters(
+                    {"contacts": [contact.id], **{f"{contact.id}.{k}": v for k, v in updated.items()}}
+                ).contact(contact.id)
+            except (ConfigError, ValueError) as exc:
+                at = float(experiment.time(np.array([restart.ns]))[0])
+                raise InputError(
+                    f"the logged parameter change at t = {at:.6g} s ({', '.join(changed) or 'nothing'}) "
+                    f"cannot apply to the --scene contact {contact.id!r}: {exc}"
+                ) from None
+        found.append(Material(current, restart.ns, changed, replaced, given))
+        node_before = node_after
+    return found
+
+
 def run_model(
     contact: ContactConfig,
     experiment: Experiment,
     *,
     progress: Callable[[int], Any] | None = None,
     parameters: bool = True,
+    changes: list[ContactConfig] | None = None,
 ) -> ModelRun:
     """Run ``contact``'s model over ``experiment`` from a fresh state (the node's event loop).
 
@@ -731,8 +883,10 @@ def run_model(
     `ContactSimulator.step_depths` call per stretch between force inputs; force inputs and
     the stamps they hold run event by event. A node log's restarts (RESET, PARAMETERS) start
     a fresh simulator where they were logged, and the next input a new time base, as the node
-    does; ``parameters=False`` keeps ``contact`` through PARAMETERS events (a fit's trial).
-    ``progress(k)`` is called with the number of events done since the last call.
+    does; ``parameters=False`` keeps ``contact`` through PARAMETERS events (a fit's trial);
+    ``changes``: the contact each PARAMETERS event restarts with, in order (default: the one
+    the event carries; `materials`). ``progress(k)`` is called with the number of events done
+    since the last call.
     """
     from viscoadh_ros.core.simulator import STEP_OUTPUT_FIELDS
 
@@ -747,9 +901,14 @@ def run_model(
     # Pieces between restarts; each: measured samples before its first input (the node's hold
     # timer on a fresh contact), then the inputs and samples from its first input on.
     cuts = np.flatnonzero(kind == 2)
+    # The k-th PARAMETERS event of the record restarts with changes[k].
+    rank = {i: k for k, i in enumerate(i for i, r in enumerate(restarts) if r.kind == PARAMETERS)}
+    if changes is not None and len(changes) != len(rank):
+        raise ValueError(f"{len(changes)} contacts for the record's {len(rank)} parameter changes")
     for lo, hi in zip(np.concatenate(([0], cuts + 1)), np.concatenate((cuts, [kind.size])), strict=True):
         if lo > 0 and parameters and restarts[int(index[lo - 1])].kind == PARAMETERS:
-            contact = changed_contact(restarts[int(index[lo - 1])], contact.id)
+            at = int(index[lo - 1])
+            contact = changed_contact(restarts[at], contact.id) if changes is None else changes[rank[at]]
         inputs = np.flatnonzero(kind[lo:hi] == 0)
         first = lo + int(inputs[0]) if inputs.size else hi
         if first > lo:

@@ -1299,7 +1299,7 @@ def fit_bag(path: str, options: dict[str, Any]) -> FileFit:
     import yaml
 
     from viscoadh_ros.core.config import SceneConfig
-    from viscoadh_ros.experiment import choose_contact, load_experiment
+    from viscoadh_ros.experiment import choose_contact, load_experiment, materials
     from viscoadh_ros.io.bag import Bag
     from viscoadh_ros.io.csv_io import check_output_folder
     from viscoadh_ros.io.mcap_log import plain
@@ -1344,10 +1344,23 @@ def fit_bag(path: str, options: dict[str, Any]) -> FileFit:
         scene = SceneConfig.from_dict(stored)
     contact = choose_contact(scene, opts["contact"], experiment.input_topic)
     # A node log with a runtime parameter change: the side of it the samples are on, started
-    # from the contact the change set (unless a start scene is given).
+    # from the contact in force there, as `viscoadh replay` runs it (`materials`): the contact
+    # the change set, or with --scene the scene's with the parameters the changes set (its held
+    # parameters are then those the node ran; 0.10.0 held the scene's own).
+    stretches = None
+    logged_changes = [r for r in experiment.restarts if r.kind == PARAMETERS]
+    if logged_changes:
+        given = opts["scene"] is not None
+        logged = None
+        if given and bag.scene() is not None:
+            try:
+                logged = SceneConfig.from_dict(bag.scene()).contact(contact.id)
+            except ValueError:
+                logged = None
+        stretches = materials(experiment, contact, logged=logged, given=given)
     experiment, change = fitted_stretch(experiment, fit_options, contact)
-    if change is not None and opts["scene"] is None:
-        contact = changed_contact(change, contact.id)
+    if change is not None and stretches is not None:
+        contact = stretches[logged_changes.index(change) + 1].contact
     result = fit(contact, experiment, free, kelvin=kelvin, options=fit_options)
     contacts = tuple(result.contact if c.id == contact.id else c for c in scene.contacts)
     fitted = dataclasses.replace(scene, contacts=contacts)

@@ -105,7 +105,7 @@ def plot_loops(
         ax_d.plot(curve.depth * d_k, curve.force * f_k, lw=1.6, label=curve.label)
         ax_a.plot(curve.contact_radius * a_k, curve.force * f_k, lw=1.6, label=curve.label)
     if reference is not None:
-        a_max = max(float(np.max(c.contact_radius)) for c in curves) * 1.15 or 1.0
+        a_max = max(float(np.nanmax(c.contact_radius)) for c in curves) * 1.15 or 1.0
         radius = np.linspace(0.0, a_max, 400)
         for work, style, name in (
             (reference.work_indentation, "--", "JKR indentation, w_eff1"),

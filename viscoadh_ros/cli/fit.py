@@ -103,7 +103,9 @@ def main(args: argparse.Namespace) -> int:
         f"{result.model_runs} model runs, {result.wall_time:.3g} s):"
     )
     if done.changed_at is not None:
-        start = "--scene" if args.scene is not None else "the contact it set"
+        start = (
+            "--scene with the parameters the change set" if args.scene is not None else "the contact it set"
+        )
         print(f"  the record from the parameter change at t = {done.changed_at:.6g} s on; start: {start}")
     for name, value in result.values.items():
         unit = unit_of(name)

@@ -142,8 +142,25 @@ def main(argv: Sequence[str] | None = None) -> int:
         return int(module.main(args))
     except KeyboardInterrupt:
         return 130
+    except BrokenPipeError:
+        # The reader of stdout went away (`viscoadh replay ... | head`): stop quietly, with the
+        # exit status of a process SIGPIPE ended (128 + 13), and no traceback at exit either.
+        _drop_stdout()
+        return 141
     except Exception as exc:
         if isinstance(exc, _user_error_types()):
             print(f"{PROG} {args.verb}: error: {exc}", file=sys.stderr)
             return 2
         raise
+
+
+def _drop_stdout() -> None:
+    """Point stdout at the null device, so the interpreter's flush at exit does not raise
+    BrokenPipeError again (the recipe of Python's `signal` documentation)."""
+    import os
+
+    try:
+        null = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(null, sys.stdout.fileno())
+    except (OSError, ValueError):  # no file descriptor (a test's captured stdout)
+        pass

@@ -22,17 +22,19 @@ from viscoadh_ros.cli._paths import refuse_overwrite
 from viscoadh_ros.core.errors import InputError
 from viscoadh_ros.experiment import (
     Experiment,
+    Material,
     ModelRun,
     choose_contact,
     compare,
     load_experiment,
+    materials,
     run_model,
 )
 from viscoadh_ros.io.bag import Bag
 from viscoadh_ros.io.csv_io import check_output_folder
 
 if TYPE_CHECKING:
-    from viscoadh_ros.core.config import SceneConfig
+    from viscoadh_ros.core.config import ContactConfig, SceneConfig
 
 
 def add_input_arguments(parser: argparse.ArgumentParser) -> None:
@@ -200,26 +202,32 @@ def main(args: argparse.Namespace) -> int:
             check_output_folder(path)
     result, experiment = replay_one(args, progress=True)
     skipped = experiment.rejected_index.size
+    stretches = result.pop("_materials")
+    # Every file written before the summary is printed: a reader that stops early (`| head`)
+    # loses only the text.
+    if args.json is not None:
+        args.json.write_text(json.dumps(result, indent=2) + "\n", encoding="utf-8")
     print(
         f"replayed {experiment.input_ns.size} inputs of {result['contact']} over "
         f"{experiment.duration:.3f} s at {result['replay_speed_x_real_time']:.3g}x real time"
         + (f" (skipped {skipped} the node rejected)" if skipped else "")
         + (f" ({len(experiment.restarts)} resets/parameter changes applied)" if experiment.restarts else "")
+        + "".join(f"\n  material {text}" for text in (stretches if len(stretches) > 1 else ()))
         + f"\nforce error vs {experiment.force_topic}: RMSE {result['rmse_N']:.6g} N, "
         f"max {result['max_error_N']:.6g} N ({result['samples']} samples)\n"
         f"pull-off force: measured {_pull_off_text(result['measured_pull_off_force_N'])}, "
         f"model {_pull_off_text(result['model_pull_off_force_N'])}\n"
         f"wrote {args.output}"
     )
-    if args.json is not None:
-        args.json.write_text(json.dumps(result, indent=2) + "\n", encoding="utf-8")
     return 0
 
 
 def replay_one(args: argparse.Namespace, *, progress: bool = False) -> tuple[dict, Experiment]:
     """Replay ``args.bag`` into ``args.output``: the summary row and the experiment."""
-    _, scene, experiment = open_experiment(args)
+    bag, scene, experiment = open_experiment(args)
     contact = choose_contact(scene, args.contact, experiment.input_topic)
+    stretches, start = _materials(args, bag, contact, experiment)
+    changes = [m.contact for m in stretches[1:]]
 
     if progress and sys.stderr.isatty():
         # A bar on a terminal only (as tqdm's disable=None decides); tqdm is not imported
@@ -228,9 +236,9 @@ def replay_one(args: argparse.Namespace, *, progress: bool = False) -> tuple[dic
 
         events = experiment.input_ns.size + experiment.measured_ns.size
         with tqdm(total=events, unit="step", file=sys.stderr, leave=False) as bar:
-            run = run_model(contact, experiment, progress=bar.update)
+            run = run_model(contact, experiment, progress=bar.update, changes=changes)
     else:
-        run = run_model(contact, experiment)
+        run = run_model(contact, experiment, changes=changes)
     summary = compare(experiment, run)
     _write_output(args.output, scene, contact.id, experiment, run)
     result = {
@@ -241,8 +249,40 @@ def replay_one(args: argparse.Namespace, *, progress: bool = False) -> tuple[dic
         "output": str(args.output),
         **summary.as_dict(),
         **_event_counts(experiment),
+        "materials": [m.as_dict(experiment) for m in stretches],
+        "_materials": [m.describe(experiment, start) for m in stretches],
     }
     return result, experiment
+
+
+def _materials(
+    args: argparse.Namespace, bag: Bag, contact: ContactConfig, experiment: Experiment
+) -> tuple[list[Material], str]:
+    """The contact each stretch between the record's parameter changes runs with
+    (`experiment.materials`), and what the first is, in words.
+
+    Without --scene: the node's, as logged. With --scene (a candidate material compared with
+    the log): the scene's contact, and at each logged PARAMETERS event the parameters that
+    event changed set on it (docs/recording_and_replay.md); 0.10.0 and before ran the logged
+    contact after a change whatever the scene (an outside tester's candidate replayed bit for
+    bit as the node's own answer)."""
+    if args.scene is None:
+        return materials(experiment, contact, logged=None, given=False), "the scene stored in the log"
+    from viscoadh_ros.core.config import SceneConfig
+    from viscoadh_ros.core.errors import ConfigError
+
+    start = f"{contact.id!r} of --scene {str(args.scene)!r}"
+    logged = None
+    stored = bag.scene()
+    if stored is not None:
+        try:
+            logged = SceneConfig.from_dict(stored).contact(contact.id)
+        except (ConfigError, ValueError):
+            logged = None
+    found = materials(experiment, contact, logged=logged, given=True)
+    if len(found) > 1 and logged is None:
+        start += " (the log stores no scene of the contact: its changes are taken against --scene)"
+    return found, start
 
 
 def replay_file(path: str, options: dict) -> dict:
@@ -255,6 +295,7 @@ def replay_file(path: str, options: dict) -> dict:
         scene=None if options.get("scene") is None else Path(options["scene"]),
     )
     result, _ = replay_one(args)
+    result["materials"] = "; ".join(result.pop("_materials"))
     return {"status": "ok", **result}
 
 

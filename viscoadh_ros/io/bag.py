@@ -17,6 +17,7 @@ unless ``recover=True``.
 
 from __future__ import annotations
 
+import re
 import struct
 import zlib
 from collections.abc import Iterable, Iterator
@@ -122,11 +123,61 @@ def _bag_files(path: Path) -> list[Path]:
                 f"bag folder {str(path)!r}: files listed in metadata.yaml are missing: {missing}"
             )
     else:
-        # A folder whose recorder was killed has no metadata.yaml yet: take its files in order.
-        files = sorted(path.glob("*.mcap"), key=lambda f: (len(f.name), f.name))
+        # A folder whose recorder was killed has no metadata.yaml yet, or the files of a rotated
+        # `.mcap` log put in one folder: take its files in the order of their numbers.
+        files = _numbered_files(path, list(path.glob("*.mcap")))
     if not files:
         raise InputError(f"bag folder {str(path)!r} holds no .mcap file")
     return files
+
+
+_NUMBERED = re.compile(r"(.+)_(\d+)\.mcap")
+
+
+def _numbered_files(folder: Path, files: list[Path]) -> list[Path]:
+    """The files of a folder without ``metadata.yaml`` in log order: one log's
+    ``<stem>_<i>.mcap`` files (a rotated log, a killed rosbag2 recorder's folder), by number,
+    the numbers consecutive. InputError naming the files otherwise: a folder holding files of
+    several logs, a file not numbered as the others, or a number missing (an outside tester's
+    folders replayed with exit 0 and wrong forces: a rotated log without file 7, with a copy of
+    file 1, and two sessions' logs together)."""
+    if len(files) < 2:
+        return files
+    stems: dict[str, list[tuple[int, Path]]] = {}
+    loose = []
+    for file in files:
+        match = _NUMBERED.fullmatch(file.name)
+        if match is None:
+            loose.append(file.name)
+        else:
+            stems.setdefault(match.group(1), []).append((int(match.group(2)), file))
+    where = f"bag folder {str(folder)!r} (no metadata.yaml)"
+    advice = "replay a folder that holds the files of one log, all of them"
+    if loose:
+        raise InputError(
+            f"{where}: {', '.join(sorted(loose))} {'is' if len(loose) == 1 else 'are'} not numbered as "
+            "the files of one rotated log (<stem>_0.mcap, <stem>_1.mcap, ...), so their place in the "
+            f"log is unknown (a copy, or another recording?); {advice}"
+        )
+    if len(stems) > 1:
+        logs = ", ".join(f"{stem}_*.mcap ({len(numbered)} files)" for stem, numbered in sorted(stems.items()))
+        raise InputError(f"{where} holds the files of several logs: {logs}; {advice}")
+    ((stem, numbered),) = stems.items()
+    numbered.sort(key=lambda item: item[0])
+    numbers = [n for n, _ in numbered]
+    repeated = sorted({n for n in numbers if numbers.count(n) > 1})
+    if repeated:
+        names = [f.name for n, f in numbered if n == repeated[0]]
+        raise InputError(f"{where}: {', '.join(names)} have the same number in the log; {advice}")
+    missing = sorted(set(range(numbers[0], numbers[-1] + 1)) - set(numbers))
+    if missing:
+        names = ", ".join(f"{stem}_{n}.mcap" for n in missing[:5]) + (" ..." if len(missing) > 5 else "")
+        raise InputError(
+            f"{where}: the rotated log {stem}_*.mcap lacks {names} (it holds {stem}_{numbers[0]}.mcap "
+            f"to {stem}_{numbers[-1]}.mcap): the commands in the missing file(s) would be left out "
+            f"and the contact's history broken; {advice}"
+        )
+    return [f for _, f in numbered]
 
 
 def _unaligned(buffer: NDArray[np.uint8], dtype: str) -> NDArray:
@@ -200,12 +251,25 @@ class Bag:
     def __init__(self, path: str | Path, *, recover: bool = False) -> None:
         self.path = Path(path)
         self.files = _bag_files(self.path)
+        #: The metadata records by name; a key in several files keeps the first file's value
+        #: (the scene the record starts with: a rotated log's later files store the scene in
+        #: force when each was started, `file_metadata`).
         self.metadata: dict[str, dict[str, str]] = {}
+        #: Each file's own metadata records, in the order of `files`.
+        self.file_metadata: list[dict[str, dict[str, str]]] = []
+        #: The position in the recording (``order``) of each file's first message.
+        self.file_starts: list[int] = []
         self.truncated: list[Path] = []
         self._topics: dict[str, _Topic] = {}
         self._records = 0
         for file in self.files:
+            self.file_starts.append(self._records)
+            self.file_metadata.append({})
             self._read_file(file, recover)
+            for name, record in self.file_metadata[-1].items():
+                merged = self.metadata.setdefault(name, {})
+                for key, value in record.items():
+                    merged.setdefault(key, value)
         if self.truncated and self._records == 0:
             names = ", ".join(repr(str(f)) for f in self.truncated)
             raise InputError(
@@ -251,7 +315,7 @@ class Bag:
                     elif opcode == Opcode.CHANNEL:
                         channels[record.id] = record
                     else:
-                        self.metadata.setdefault(record.name, {}).update(record.metadata)
+                        self.file_metadata[-1].setdefault(record.name, {}).update(record.metadata)
                 elif opcode == Opcode.FOOTER:
                     finished = True
             self._flush(channels, schemas)
@@ -500,9 +564,16 @@ class Bag:
                 ) from None
             yield RecordedMessage(name, self._topics[name].type_name, log_time, msg, order)
 
-    def scene(self) -> dict[str, Any] | None:
-        """The scene stored by our recorder (``SceneConfig.to_dict()`` form), if any."""
-        text = self.metadata.get(METADATA_NAME, {}).get(SCENE_KEY, "")
+    def file_of(self, order: int) -> int:
+        """The index in `files` of the file holding the message at position ``order``."""
+        return int(np.searchsorted(np.asarray(self.file_starts), order, side="right")) - 1
+
+    def scene(self, file: int | None = None) -> dict[str, Any] | None:
+        """The scene stored by our recorder (``SceneConfig.to_dict()`` form), if any: the one
+        the record starts with (its first file's), or file ``file``'s (the scene in force when
+        the recorder started that file)."""
+        metadata = self.metadata if file is None else self.file_metadata[file]
+        text = metadata.get(METADATA_NAME, {}).get(SCENE_KEY, "")
         if not text:
             return None
         try:

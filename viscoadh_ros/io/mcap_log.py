@@ -5,7 +5,9 @@ Files follow what rosbag2 (Jazzy) writes, so ``ros2 bag``, the ``mcap`` reader a
 dependencies), ``cdr`` payloads from :func:`rclpy.serialization.serialize_message`, channel
 metadata ``offered_qos_profiles``. Every file also carries a metadata record
 :data:`METADATA_NAME` with the scene (``SceneConfig.to_dict()`` as YAML) and the software
-version, so one file alone is enough to replay the run.
+version, so one file alone is enough to replay the run: the scene in force when the file was
+started (:meth:`McapRecorder.set_scene` after a runtime parameter change; the change itself is
+a PARAMETERS event among the messages).
 
 Crash safety: chunks are bounded (``chunk_size`` bytes) and each finished chunk is handed
 to the operating system at once, so a process killed with SIGKILL leaves every message up
@@ -107,7 +109,7 @@ class TopicQos:
 
 @dataclass
 class _Item:
-    topic: str
+    topic: str | None  # None: not a message, the metadata (`data`) of the files started from here
     type_name: str
     # CDR bytes, or the message itself when the caller handed it over (serialised by the writer).
     data: Any
@@ -421,7 +423,8 @@ class McapRecorder:
 
     Args:
         path: ``*.mcap`` file, or a folder (rosbag2 layout) for any other name.
-        scene: ``SceneConfig.to_dict()`` of the run (stored as YAML in every file).
+        scene: ``SceneConfig.to_dict()`` of the run (stored as YAML in every file; :meth:`set_scene`
+            changes it for the files started later).
         chunk_size: Target chunk size, bytes (> 0): the most a SIGKILL can lose.
         max_bytes: Start a new file after this many bytes (0 = never).
         max_duration: Start a new file after this many seconds of log time (0 = never).
@@ -458,6 +461,7 @@ class McapRecorder:
         self._max_duration_ns = int(max_duration * 1e9)
         self._qos = dict(qos or {})
         self._metadata = _metadata(scene)
+        self._start_metadata = self._metadata  # metadata.yaml's: the scene the log starts with
         self._queue_size = queue_size
         self._pending: deque[_Item] = deque()
         self._dropped = 0
@@ -524,6 +528,14 @@ class McapRecorder:
         ``type_name`` (``pkg/msg/Type``) message. Never blocks; False when dropped."""
         return self._put(_Item(topic, type_name, payload, int(stamp_ns)))
 
+    def set_scene(self, scene: Mapping[str, Any] | None) -> None:
+        """The scene in force from now on (a runtime parameter change): the files started after
+        the messages recorded so far store it, so each file names the scene in force when it
+        started (events in it carry later changes). Queued in order with the messages, never
+        dropped (a full queue would otherwise leave the later files naming a stale scene)."""
+        if not self._closed and self._error is None:
+            self._pending.append(_Item(None, "", _metadata(scene), 0))
+
     def _put(self, item: _Item) -> bool:
         if self._closed or self._error is not None or len(self._pending) >= self._queue_size:
             self._dropped += 1
@@ -579,6 +591,9 @@ class McapRecorder:
                     if self._closed and not pending:
                         break
                     time.sleep(WRITER_POLL_S)
+                    continue
+                if item.topic is None:
+                    self._metadata = item.data
                     continue
                 self._rotate_if_due(item.stamp_ns)
                 if self._file is None:
@@ -651,7 +666,7 @@ class McapRecorder:
             "compression_mode": "",
             "relative_file_paths": [f.path.name for f in self._finished],
             "files": files,
-            "custom_data": {SCENE_KEY: self._metadata[SCENE_KEY], VERSION_KEY: __version__},
+            "custom_data": {SCENE_KEY: self._start_metadata[SCENE_KEY], VERSION_KEY: __version__},
             "ros_distro": "jazzy",
         }
         text = yaml.safe_dump({"rosbag2_bagfile_information": info}, sort_keys=False)

@@ -25,7 +25,7 @@ import operator
 import sys
 import threading
 import time
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any, Protocol
 
 import rclpy
@@ -118,6 +118,9 @@ class Recorder(Protocol):
 
     def record_cdr(self, topic: str, type_name: str, payload: bytes, stamp_ns: int) -> bool:
         """:meth:`record` for an already serialised ``type_name`` message."""
+
+    def set_scene(self, scene: Mapping[str, Any] | None) -> None:
+        """The scene in force from now on, for the files started after what was recorded."""
 
     def close(self) -> None:
         """Finish the log."""
@@ -1125,6 +1128,10 @@ class ViscoadhNode(Node):
                     )
             for contact_id in touched:
                 self.contacts[contact_id].replace_config_locked(scene.contact(contact_id), scene)
+            if self._recorder is not None:
+                # After the PARAMETERS events and before the touched contacts' next commands (their
+                # locks are held): a file the recorder starts from here on names the new scene.
+                self._recorder.set_scene(scene.to_dict())
         if scene.node.publish_rate != self.scene.node.publish_rate:
             for contact in self.contacts.values():
                 contact.set_publish_rate(scene.node.publish_rate)
