@@ -96,3 +96,20 @@ def test_a_zero_time_jump_to_another_depth_still_moves_the_contact() -> None:
     after = simulator.step(float(t[59]), depth=before.depth + 10e-6)
     assert after.contact_radius > before.contact_radius
     assert after.force > before.force
+
+
+@pytest.mark.parametrize("preset", ["fast", "balanced"])
+def test_a_contact_at_rest_commanded_to_its_own_depth_snaps_in(preset: str) -> None:
+    """Not a repeat: a fresh (or reset) contact rests at depth 0 without contact, and a first
+    command to depth 0 at its reset time snaps an adhesive contact in (docs/ros_interface.md;
+    the outside tester's check of this round's first version of the fix, which answered 0 N).
+    Then the same command again is a repeat. `step` and `step_depths` alike."""
+    stepped = _simulator(preset)
+    first = stepped.step(0.0, depth=0.0)
+    assert first.contact_radius > 0.0 and first.force < 0.0
+    assert stepped.step(0.0, depth=0.0) == first
+    batch = _simulator(preset).step_depths(np.zeros(2), np.zeros(2))
+    assert batch["force"][0] == batch["force"][1] == first.force
+    assert batch["contact_radius"][1] == first.contact_radius
+    stepped.reset(0.0)
+    assert stepped.step(0.0, depth=0.0).force == first.force

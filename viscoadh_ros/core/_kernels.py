@@ -2948,12 +2948,15 @@ def _advance_from(
     crossing = False
     # Largest |wsum| after the last accepted substep (summed with its update; K = 0: no memory).
     peak = 0.0
-    if dt <= 0.0 and d1 == d0:
-        # A repeated sample (no time, the same depth) is the state as it is: nothing moves.
-        # The unlimited edge search below could move an edge that the timed step left on its
-        # detachment root (the elements it just released sit at their attachment threshold)
-        # and publish another force for the same instant and depth (an outside tester, 0.10.0:
-        # a log with every message recorded twice replayed to a pull-off 0.8 % deeper).
+    if dt <= 0.0 and d1 == d0 and (a > 0.0 or _memory_peak(wsum) > 0.0):
+        # A repeated sample (no time, the same depth) of a contact with a history is the
+        # state as it is: nothing moves. The unlimited edge search below could move an edge
+        # that the timed step left on its detachment root (the elements it just released sit
+        # at their attachment threshold) and publish another force for the same instant and
+        # depth (an outside tester, 0.10.0: a log with every message recorded twice replayed
+        # to a pull-off 0.8 % deeper). Without contact or memory the search stays: a contact
+        # at rest commanded to its own depth (0 after a reset) snaps in there
+        # (docs/ros_interface.md).
         force_same = force_prev if force_prev == force_prev else _force(
             a, d1, wsum, bsum, dx, g_c, gf, gint, df, e0, kap, diss
         )

@@ -1398,6 +1398,17 @@ class Snapshot:
     contact: Any = None  # the ContactConfig it was taken of
 
 
+def _rest_like(output: StepOutput) -> bool:
+    """An output a contact at rest has (after a reset: no contact, no force, no energy): a
+    command to its depth at its time is a command, not a repeat (`ContactSimulator._repeats`)."""
+    return (
+        output.contact_radius == 0.0
+        and output.force == 0.0
+        and output.energy_input == 0.0
+        and output.energy_dissipated == 0.0
+    )
+
+
 class ContactSimulator:
     """One adhesive viscoelastic contact, stepped in time.
 
@@ -1935,7 +1946,14 @@ class ContactSimulator:
         caller compares the times): the same depth under depth control, the same force under
         force control; floats only (other types go the general path, which checks them)."""
         if force is None:
-            return isinstance(depth, float) and self._held_force is None and depth == self._depth
+            # Not from rest: a contact at rest (after a reset) commanded to its own depth is a
+            # command, not a repeat (an adhesive contact snaps in at depth 0).
+            return (
+                isinstance(depth, float)
+                and self._held_force is None
+                and depth == self._depth
+                and not _rest_like(self._output)
+            )
         return depth is None and isinstance(force, float) and force == self._held_force
 
     def _step_transaction(self, time: float, depth: float | None, force: float | None) -> StepOutput:
@@ -2082,13 +2100,16 @@ class ContactSimulator:
         v_c1, v_c2 = physics.critical_speeds
         ok = (edge_speed == 0.0) | (np.abs(edge_speed) >= np.where(edge_speed > 0.0, v_c1, v_c2))
         # A repeated sample (`step`'s `_repeats`: the same depth at the same instant after a
-        # depth step) publishes the step before it as it was; the kernel left the state alone.
-        repeated = (dt == 0.0) & (d == np.concatenate(([self._depth], d[:-1])))
+        # depth step, not from rest) publishes the step before it as it was; the kernel left
+        # the state alone.
+        before = self._output
+        rest_like = (radius == 0.0) & (force == 0.0) & (energy_input == 0.0) & (dissipated == 0.0)
+        rest_like = np.concatenate(([_rest_like(before)], rest_like[:-1]))
+        repeated = (dt == 0.0) & (d == np.concatenate(([self._depth], d[:-1]))) & ~rest_like
         repeated[0] &= self._held_force is None
         if repeated.any():
             rows = np.arange(t.size)
             source = np.maximum.accumulate(np.where(repeated, -1, rows))
-            before = self._output
             for values, first in (
                 (phase, int(before.phase)),
                 (edge_speed, before.edge_speed),
