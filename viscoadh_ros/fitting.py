@@ -1498,9 +1498,11 @@ def fit_bag(path: str, options: dict[str, Any]) -> FileFit:
 
 def fit_file(path: str, options: dict[str, Any]) -> dict[str, Any]:
     """One summary row for the bag at ``path`` (the batch runner's unit of work; picklable,
-    top level): ``bag``, ``contact``, ``status`` (``ok``, ``unidentified`` or ``failed``),
-    ``reason``, every fitted value with its 95 % interval (``<name>_lo95``/``_hi95``), standard
-    deviation (``<name>_sigma``) and ``<name>_identified``, ``rmse_N``, ``noise_N``, ``r2``,
+    top level): ``bag``, ``contact``, ``status`` (``ok``, ``unidentified``, ``misfit`` or
+    ``failed``), ``reason``, every fitted value with its 95 % interval (``<name>_lo95``/``_hi95``),
+    standard deviation (``<name>_sigma``) and ``<name>_identified``; with ``fit_offset`` the
+    load-cell offset ``offset_N`` with ``offset_lo95_N``/``offset_hi95_N``/``offset_sigma_N``,
+    without it the offset check's score ``offset_z``; ``rmse_N``, ``noise_N``, ``r2``,
     ``samples``, ``model_runs``, ``wall_time_s`` and the files written. ``options`` as
     `FILE_OPTIONS`. Never raises: a bag that cannot be fitted is a row with status
     ``failed`` and the reason."""
