@@ -48,6 +48,12 @@ def table(result: FitResult, title: str = "") -> str:
             lines.append("| " + " | ".join(cells) + " |")
         else:
             lines.append(f"| {name} | {value:.6g} | held | | | {unit_of(name)} |")
+    if result.offset is not None and result.offset_interval is not None:
+        lo, hi = result.offset_interval
+        lines.append(
+            f"| load-cell offset | {result.offset:.4g} | {lo:.4g} .. {hi:.4g} | "
+            f"{result.offset_uncertainty:.2g} N | yes | N |"
+        )
     ratio = result.rmse / result.noise if result.noise > 0 else float("nan")
     grid = result.model_contact.numerics
     lines += [
@@ -63,8 +69,20 @@ def table(result: FitResult, title: str = "") -> str:
         f"over {1e6 * grid.domain_radius:.4g} um",
         "- intervals: linearised (central secant over about 3 standard deviations) with the residual "
         "variance, plus the shift of the optimum under the last grid refinement, in quadrature",
-        "",
     ]
+    if result.offset is not None:
+        lines.append(
+            "- load-cell offset (what the load cell reads at zero force) fitted beside the parameters "
+            "and subtracted from the record: the model plus it is fitted, the residuals and RMSE are "
+            "its; its sigma is that of the augmented fit (noise over the samples and the parameters' "
+            "covariance through the mean force's slope) plus the grid refinement's shift"
+        )
+    elif np.isfinite(result.offset_score):
+        lines.append(
+            f"- offset check: score z = {result.offset_score:.2f} for a constant force offset "
+            "(|z| > 4 is a misfit: tare the record or fit with --fit-offset)"
+        )
+    lines.append("")
     return "\n".join(lines)
 
 
@@ -91,6 +109,8 @@ def write_report(
     run = run_model(result.model_contact, experiment, parameters=False)  # as the fit ran it
     t = experiment.time(experiment.measured_ns)
     measured, model, used = experiment.measured_force, run.model_force, result.used
+    if result.offset is not None:
+        model = model + result.offset  # what the load cell would read: the fitted record's scale
     depth = _depth_at(experiment, experiment.measured_ns)
     mn, um = 1e3, 1e6
 
@@ -100,11 +120,12 @@ def write_report(
     ax_t.scatter(t[used], measured[used] * mn, color="0.45", label="measured (fitted)", **dot)
     if not np.all(used):
         ax_t.scatter(t[~used], measured[~used] * mn, color="tab:orange", marker="x", s=12, label="left out")
-    ax_t.plot(t, model * mn, color="tab:blue", lw=1.3, label="fitted model")
+    label = "fitted model" if result.offset is None else f"fitted model + offset {result.offset * mn:.3g} mN"
+    ax_t.plot(t, model * mn, color="tab:blue", lw=1.3, label=label)
     ax_t.set(xlabel="time t / s", ylabel="force F / mN  (> 0 compressive)", title="force vs time")
 
     ax_d.scatter(depth[used] * um, measured[used] * mn, color="0.45", label="measured", **dot)
-    ax_d.plot(depth * um, model * mn, color="tab:blue", lw=1.1, label="fitted model")
+    ax_d.plot(depth * um, model * mn, color="tab:blue", lw=1.1, label=label)
     reference = JkrReference.from_contact(result.contact)
     if reference is not None:
         radius = np.linspace(0.0, 1.15 * float(np.max(run.input_columns["contact_radius"])), 300)

@@ -64,6 +64,22 @@ How it finds the optimum from a poor start (issue 12):
    The 95 % interval is ``u - 1.96 sigma_low .. u + 1.96 sigma_high`` (asymmetric in the
    parameter, and in u where the profile is); the stated standard deviation is the mean of
    the two. Their coverage is tested on seeded synthetic records (tests/test_fit_coverage.py).
+6. **A load-cell offset** (what the load cell reads at zero force, N; the record is the model
+   plus it). With ``FitOptions.fit_offset`` it is fitted beside the parameters by variable
+   projection: every residual the fit sees (``_Problem.residual``: coarse, medium, polish,
+   profiles, the refined grid's) is ``model - measured`` less its mean over the used samples,
+   the best offset at that trial, so the secants, the covariance, the profiles and the
+   model-error term all see it profiled out. Its value is ``mean(measured - model)`` at the
+   optimum; its variance that of the augmented fit ``[J_raw, 1]``: ``s^2 / n + m^T C m`` (``m``
+   the secant of the mean unprofiled residual, ``C`` the parameters' covariance with the
+   profile widening), plus the shift the refined grid gives it, in quadrature. Without the
+   option a score (Lagrange-multiplier) test for one at the optimum,
+   ``z = sum(r) / (s sqrt(n - 1^T J (J^T J)^-1 J^T 1))`` (:func:`offset_score`), marks a fit
+   with ``|z| >`` :data:`OFFSET_SIGMAS` as a misfit: the residual correlation subtracts the mean
+   and cannot see an offset, and the parameters absorb most of one (1 % of the peak force moved
+   G0 by +12 % at RMSE/noise 1.00). The test sees an offset only where it is not absorbed: one
+   of 0.3 % of the peak (z about 0.6 on the standard record) still moves G0 by 5 %; a record
+   from a load cell that may not be tared needs the option (tests/test_fit_offset.py).
 
 A parameter the record cannot identify (no dependence, a flat valley with another one, or a
 relative standard deviation above :data:`MAX_RELATIVE_UNCERTAINTY`) is reported as not
@@ -276,13 +292,16 @@ class FitOptions:
     segment: which measured samples count: ``both``, ``approach`` (the depth last moved
     down into the body) or ``retract`` (it last moved out). time_range: ``(t0, t1)`` s since
     the first input, or None for all. bounds_factor: the box, start/f .. start*f (> 1).
-    seed: of the global stage's Sobol points.
+    seed: of the global stage's Sobol points. fit_offset: fit a constant load-cell offset
+    beside the parameters (what the load cell reads at zero force, N; profiled out of every
+    residual, see :func:`fit`); off, the fit tests for one (:data:`OFFSET_SIGMAS`).
     """
 
     segment: str = "both"
     time_range: tuple[float, float] | None = None
     bounds_factor: float = BOUNDS_FACTOR
     seed: int = 0
+    fit_offset: bool = False
 
     def __post_init__(self) -> None:
         if self.segment not in SEGMENTS:
@@ -328,6 +347,15 @@ class FitResult:
     #: deviations of the parameter (the stationarity test's number).
     stationarity: float = 0.0
     model_time: float = 0.0  # s of wall_time spent running the model
+    #: The fitted load-cell offset (N, what the load cell reads at zero force: the model plus
+    #: it is what the record is fitted to), its standard deviation and 95 % interval; None
+    #: (nan) when the fit ran without one (`FitOptions.fit_offset`).
+    offset: float | None = None
+    offset_uncertainty: float = math.nan
+    offset_interval: tuple[float, float] | None = None
+    #: Without a fitted offset: the score statistic for adding one (standard deviations;
+    #: |z| > OFFSET_SIGMAS is status "misfit"); nan with one.
+    offset_score: float = math.nan
 
     def row(self) -> dict[str, Any]:
         """One flat summary row (the batch runner's table): every value, its interval and
@@ -339,6 +367,12 @@ class FitResult:
                 row[f"{name}_lo95"], row[f"{name}_hi95"] = self.interval[name]
                 row[f"{name}_sigma"] = self.uncertainty[name]
                 row[f"{name}_identified"] = self.identified[name]
+        if self.offset is not None and self.offset_interval is not None:
+            row["offset_N"] = self.offset
+            row["offset_lo95_N"], row["offset_hi95_N"] = self.offset_interval
+            row["offset_sigma_N"] = self.offset_uncertainty
+        else:
+            row["offset_z"] = self.offset_score
         row.update(
             rmse_N=self.rmse,
             noise_N=self.noise,
@@ -364,6 +398,29 @@ def noise_level(force: NDArray[np.float64]) -> float:
 #: miss the record along a smooth stretch (a local optimum, a missing Kelvin element), which
 #: the RMSE cannot tell from an error in the noise estimate but correlated residuals do.
 MISFIT_SIGMAS = 4.0
+
+
+#: Without a fitted offset, a score (Lagrange-multiplier) statistic for adding a constant force
+#: offset beyond this many standard deviations marks a misfit (`offset_score`): the residual
+#: correlation cannot see an offset (it subtracts the residuals' mean), and the parameters
+#: absorb most of one (an offset of 1 % of the peak force moved G0 by +12 % at RMSE/noise 1.00).
+OFFSET_SIGMAS = 4.0
+
+
+def offset_score(r: NDArray[np.float64], jac: NDArray[np.float64], constants: int = 0) -> float:
+    """The score statistic for adding a constant to a least-squares fit at its optimum, in
+    standard deviations (about N(0, 1) without an offset): ``sum(r) / (s sqrt(n - h))`` with
+    ``h = 1^T J (J^T J)^-1 J^T 1`` (the part of a constant the parameters' columns ``jac``
+    already span) and ``s^2 = r.r / (n - p - constants)`` the residual variance. ``r`` and
+    ``jac`` in the same units (the fit's: noise deviations)."""
+    n, p = r.size, jac.shape[1]
+    ones = np.ones(n)
+    spanned = jac @ np.linalg.lstsq(jac, ones, rcond=None)[0]
+    free = float(n - ones @ spanned)
+    s2 = float(r @ r) / max(n - p - constants, 1)
+    if not (free > 0.0 and s2 > 0.0):
+        return 0.0
+    return float(np.sum(r)) / math.sqrt(s2 * free)
 
 
 def residual_correlation(error: NDArray[np.float64]) -> float:
@@ -510,12 +567,23 @@ class _Problem:
         used: NDArray[np.bool_],
         noise: float,
         runs: int = 0,
+        *,
+        offset: bool = False,
     ) -> None:
         self.contact, self.experiment, self.free, self.kelvin = contact, experiment, tuple(free), kelvin
         self.start, self.used, self.noise = start, used, noise
         self.measured = experiment.measured_force[used]
         self.runs = runs
         self.model_time = 0.0  # s spent in run_model
+        #: A constant load-cell offset profiled out of the residuals (variable projection: at
+        #: each trial the offset that minimises the cost is the mean of measured - model, so
+        #: the residuals are those of model - measured less their mean); ``constants`` is how
+        #: many such fitted constants the degrees of freedom lose.
+        self.offset = offset
+        self.constants = int(offset)
+        self.failed = False  # the last force() was refused by the model
+        self.last_mean = 0.0  # mean of (model - measured) / noise at the last residual()
+        self.secant_means = np.zeros(len(self.free))  # d last_mean / du at the last secant()
 
     def values(self, u: NDArray[np.float64]) -> dict[str, float]:
         trial = dict(self.start)
@@ -534,19 +602,35 @@ class _Problem:
             run = run_model(trial, self.experiment, parameters=False)
         except ValueError:
             # Outside what the model accepts: a large residual steers the optimiser back.
+            self.failed = True
             return self.measured + 1e3 * self.noise * math.sqrt(self.measured.size)
         finally:
             self.model_time += wallclock.perf_counter() - started
+        self.failed = False
         return run.model_force[self.used]
 
     def residual(self, u: NDArray[np.float64]) -> NDArray[np.float64]:
-        return (self.force(u) - self.measured) / self.noise
+        """``(model - measured) / noise`` at the used samples; with ``offset`` less its mean
+        (the best constant offset at this trial profiled out). A trial the model refuses keeps
+        its large constant residual (profiled, it would vanish)."""
+        r = (self.force(u) - self.measured) / self.noise
+        self.last_mean = float(np.mean(r))
+        if self.offset and not self.failed:
+            r = r - self.last_mean
+        return r
 
     def secant(self, u: NDArray[np.float64], steps: NDArray[np.float64]) -> NDArray[np.float64]:
-        """Central-secant Jacobian of the residuals over +-``steps[j]`` in each u."""
-        columns = []
+        """Central-secant Jacobian of the residuals over +-``steps[j]`` in each u; the same
+        secant of the mean of the unprofiled residuals goes to ``secant_means`` (the offset's
+        variance needs it: the profiled columns have mean zero)."""
+        columns, means = [], []
         for h, e in zip(steps, np.eye(u.size), strict=True):
-            columns.append((self.residual(u + h * e) - self.residual(u - h * e)) / (2.0 * h))
+            plus = self.residual(u + h * e)
+            mean_plus = self.last_mean
+            minus = self.residual(u - h * e)
+            columns.append((plus - minus) / (2.0 * h))
+            means.append((mean_plus - self.last_mean) / (2.0 * h))
+        self.secant_means = np.array(means)
         return np.column_stack(columns)
 
 
@@ -753,6 +837,9 @@ class _Polished:
     steps: NDArray[np.float64]  # the last secant's half-widths
     jac: NDArray[np.float64]  # the last secant Jacobian of the residuals
     r: NDArray[np.float64]  # the residuals at u
+    #: The last secant of the mean of the unprofiled residuals (the fitted offset's column
+    #: means of the raw Jacobian, `_Problem.secant_means`); zeros without an offset.
+    means: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
 
     @property
     def sigma_u(self) -> NDArray[np.float64]:
@@ -773,12 +860,13 @@ def _polish(
     what roughness remains, narrow against the curvature (a central secant's fixed point is
     off the optimum by its width squared times the third derivative)."""
     free, p = problem.free, u.size
-    dof = max(problem.measured.size - p, 1)
+    dof = max(problem.measured.size - p - problem.constants, 1)
     r = problem.residual(u)
     steps = np.full(p, SECANT_STEP) if steps is None else steps
     sigmas = np.zeros(p)
     for _ in range(POLISH_STEPS):
         jac = problem.secant(u, steps)
+        means = problem.secant_means
         cov, flat = _covariance(jac, float(r @ r) / dof, free)
         sigma_u = np.sqrt(np.diag(cov))
         narrower = np.clip(
@@ -808,7 +896,7 @@ def _polish(
                 break
         else:
             break
-    return _Polished(u, cov, flat, sigmas, steps, jac, r)
+    return _Polished(u, cov, flat, sigmas, steps, jac, r, means)
 
 
 def _profile_cost(
@@ -903,7 +991,7 @@ def _profile_inflation(
     1 + PROFILE_BENDS + 2 + a few descents' p runs per trial point, one trial per side of a well
     identified parameter."""
     u, cov, r = polished.u, polished.cov, polished.r
-    dof = max(r.size - u.size, 1)
+    dof = max(r.size - u.size - problem.constants, 1)
     s2 = float(r @ r) / dof
     base = float(r @ r)
     target = Z95 * math.sqrt(s2)  # the square root of the rise at the 95 % end
@@ -1082,7 +1170,8 @@ def fit(
     domain, elements = fit_grid(contact, experiment, bounds)
     numerics = dataclasses.replace(contact.numerics, domain_radius=domain, elements=elements)
     grid_contact = dataclasses.replace(contact, numerics=numerics)
-    problem = _Problem(grid_contact, experiment, free, kelvin, start, used, noise)
+    offset = options.fit_offset
+    problem = _Problem(grid_contact, experiment, free, kelvin, start, used, noise, offset=offset)
     p = len(free)
     lower, upper = np.full(p, -half), np.full(p, half)
 
@@ -1103,7 +1192,7 @@ def fit(
     thinned = coarse_record(experiment, picked, thin)
     if thinned is not experiment:
         picked = np.ones(thinned.measured_force.size, dtype=bool)
-    problem = coarse = _Problem(grid_contact, thinned, free, kelvin, start, picked, noise)
+    problem = coarse = _Problem(grid_contact, thinned, free, kelvin, start, picked, noise, offset=offset)
     step = _difference_step(problem, np.zeros(p))
 
     def descend(u0: NDArray[np.float64]) -> tuple[NDArray[np.float64], float]:
@@ -1132,7 +1221,7 @@ def fit(
         descents = [descend(candidates[i]) for i in np.argsort(costs)[:GLOBAL_DESCENTS]]
         return min([(u, best), *descents], key=lambda d: d[1])
 
-    explored = noisy(2.0 * best, max(coarse.measured.size - p, 1))
+    explored = noisy(2.0 * best, max(coarse.measured.size - p - coarse.constants, 1))
     if explored:
         u, best = explore(u, best)
     if ordered:
@@ -1153,7 +1242,9 @@ def fit(
         # The coarse grid's optimum sits off the polish grid's along a flat valley (a slow
         # retardation time), where the polish's secant steps crawl at 2p runs each: descend
         # first on the thinned record at the polish's grid (a third of a full run).
-        medium = _Problem(grid_contact, thinned, free, kelvin, start, picked, noise, runs=problem.runs)
+        medium = _Problem(
+            grid_contact, thinned, free, kelvin, start, picked, noise, runs=problem.runs, offset=offset
+        )
         u = least_squares(
             medium.residual,
             np.clip(u, lower + 1e-9, upper - 1e-9),
@@ -1163,12 +1254,14 @@ def fit(
             max_nfev=DESCENT_EVALUATIONS,
         ).x
         problem.runs, model_time = medium.runs, model_time + medium.model_time
-    problem = _Problem(grid_contact, experiment, free, kelvin, start, used, noise, runs=problem.runs)
+    problem = _Problem(
+        grid_contact, experiment, free, kelvin, start, used, noise, runs=problem.runs, offset=offset
+    )
     polished = _polish(problem, u, lower, upper, smallest)
     if float(np.max(polished.sigmas)) > STATIONARY_SIGMAS:
         # The polish stopped on a rough patch: descend once more from where it got to.
         polished = _polish(problem, descend(polished.u)[0], lower, upper, smallest)
-    dof = max(problem.measured.size - p, 1)
+    dof = max(problem.measured.size - p - problem.constants, 1)
     if not explored and noisy(float(polished.r @ polished.r), dof):
         # Above the noise on every sample though the thinned set looked noise-consistent (its
         # test is sqrt(k) looser): a local valley; the global stage decides after all.
@@ -1184,8 +1277,9 @@ def fit(
     # The model-error term: the Gauss-Newton step the grid refined by 2 proposes (its residuals
     # at the optimum against this grid's secant Jacobian, one model run) less this grid's own.
     finer = dataclasses.replace(grid_contact, numerics=dataclasses.replace(numerics, elements=2 * elements))
-    refined = _Problem(finer, experiment, free, kelvin, start, used, noise, runs=problem.runs)
+    refined = _Problem(finer, experiment, free, kelvin, start, used, noise, runs=problem.runs, offset=offset)
     shift = np.linalg.lstsq(polished.jac, polished.r - refined.residual(polished.u), rcond=None)[0]
+    refined_mean = refined.last_mean  # mean of (model - measured) / noise on the refined grid
     problem.runs, model_time = refined.runs, model_time + refined.model_time
     u, cov, flat, sigmas = polished.u, polished.cov, polished.flat, polished.sigmas
     model_contact = problem.contact
@@ -1221,6 +1315,27 @@ def fit(
     force = problem.force(u)
     error = force - problem.measured
     status = "unidentified" if unidentified else "ok"
+    offset_value, offset_sigma, offset_interval, score = None, math.nan, None, math.nan
+    if offset:
+        # The offset at the optimum: the mean of measured - model (N; what the load cell reads
+        # at zero force). Its variance is that of the augmented fit [J_raw, 1] (block
+        # inversion): s^2 / n from the noise's mean plus m^T C m from the parameters' own
+        # uncertainty (m: the secant of the mean of the unprofiled residuals, C: their
+        # covariance, inflation included), plus the model-error term: how far the grid refined
+        # by 2 moves it (its mean residual at the optimum, and the parameters' shift through m).
+        n = error.size
+        offset_value = -float(np.mean(error))
+        m = polished.means
+        s2 = float(polished.r @ polished.r) / max(n - p - problem.constants, 1)
+        inflated = cov * np.outer(np.mean(inflation, axis=0), np.mean(inflation, axis=0))
+        with np.errstate(invalid="ignore", over="ignore"):
+            spread = float(m @ inflated @ m) if np.all(np.isfinite(inflated)) else math.inf
+        moved = (refined_mean + offset_value / noise) + float(m @ shift)
+        offset_sigma = noise * math.sqrt(s2 / n + spread + moved**2)
+        offset_interval = (offset_value - Z95 * offset_sigma, offset_value + Z95 * offset_sigma)
+        error = error + offset_value
+    else:
+        score = offset_score(polished.r, polished.jac)
     correlation = residual_correlation(error)
     if correlation * math.sqrt(error.size) > MISFIT_SIGMAS:
         status = "misfit"
@@ -1230,6 +1345,15 @@ def fit(
             "misses the record systematically (a local optimum, a missing Kelvin element, a wrong "
             "indenter) or the recorder filtered its noise; the values are not to be trusted as a "
             "fit and the intervals, which assume white noise, are too narrow"
+        )
+        reason = f"{misfit}; {reason}" if reason else misfit
+    if abs(score) > OFFSET_SIGMAS:
+        status = "misfit"
+        misfit = (
+            f"the residuals' mean is off zero by {abs(score):.1f} standard deviations (offset score "
+            f"z = {score:.2f}, beyond {OFFSET_SIGMAS:g}): most likely a constant force offset (a load "
+            "cell not tared); tare the record or fit with --fit-offset (FILE_OPTIONS fit_offset); "
+            "the parameters absorb most of an offset, so the values and intervals are biased"
         )
         reason = f"{misfit}; {reason}" if reason else misfit
     spread = float(np.sum((problem.measured - np.mean(problem.measured)) ** 2))
@@ -1254,6 +1378,10 @@ def fit(
         bounds=bounds,
         stationarity=float(sigmas[worst]),
         model_time=model_time + problem.model_time,
+        offset=offset_value,
+        offset_uncertainty=offset_sigma,
+        offset_interval=offset_interval,
+        offset_score=score,
     )
 
 
@@ -1271,6 +1399,7 @@ FILE_OPTIONS: dict[str, Any] = {
     "time_range": None,  # [t0, t1] s since the first input
     "bounds_factor": BOUNDS_FACTOR,
     "seed": 0,
+    "fit_offset": False,  # fit a constant load-cell offset beside the parameters (N, at zero force)
     "output": None,  # fitted scene YAML to write (+ its report beside it); None: write nothing
     "report": True,
 }
@@ -1321,6 +1450,7 @@ def fit_bag(path: str, options: dict[str, Any]) -> FileFit:
         time_range=None if time_range is None else (float(time_range[0]), float(time_range[1])),
         bounds_factor=float(opts["bounds_factor"]),
         seed=int(opts["seed"]),
+        fit_offset=bool(opts["fit_offset"]),
     )
     bag = Bag(path, recover=bool(opts["recover"]))
     experiment = load_experiment(
@@ -1381,9 +1511,11 @@ def fit_bag(path: str, options: dict[str, Any]) -> FileFit:
 
 def fit_file(path: str, options: dict[str, Any]) -> dict[str, Any]:
     """One summary row for the bag at ``path`` (the batch runner's unit of work; picklable,
-    top level): ``bag``, ``contact``, ``status`` (``ok``, ``unidentified`` or ``failed``),
-    ``reason``, every fitted value with its 95 % interval (``<name>_lo95``/``_hi95``), standard
-    deviation (``<name>_sigma``) and ``<name>_identified``, ``rmse_N``, ``noise_N``, ``r2``,
+    top level): ``bag``, ``contact``, ``status`` (``ok``, ``unidentified``, ``misfit`` or
+    ``failed``), ``reason``, every fitted value with its 95 % interval (``<name>_lo95``/``_hi95``),
+    standard deviation (``<name>_sigma``) and ``<name>_identified``; with ``fit_offset`` the
+    load-cell offset ``offset_N`` with ``offset_lo95_N``/``offset_hi95_N``/``offset_sigma_N``,
+    without it the offset check's score ``offset_z``; ``rmse_N``, ``noise_N``, ``r2``,
     ``samples``, ``model_runs``, ``wall_time_s`` and the files written. ``options`` as
     `FILE_OPTIONS`. Never raises: a bag that cannot be fitted is a row with status
     ``failed`` and the reason."""

@@ -63,6 +63,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help=f"search each free parameter within start/F .. start*F (default {BOUNDS_FACTOR:g})",
     )
     parser.add_argument("--seed", type=int, default=0, help="seed of the global search (default 0)")
+    parser.add_argument(
+        "--fit-offset",
+        action="store_true",
+        help="fit a constant load-cell offset (N, what it reads at zero force) beside the parameters "
+        "(default: none; a record whose residuals point to one is reported as a misfit)",
+    )
     parser.add_argument("--no-report", action="store_true", help="do not write the report beside SCENE")
     parser.add_argument(
         "-o", "--output", type=Path, required=True, help="scene YAML to write (a folder in batch mode)"
@@ -93,6 +99,7 @@ def main(args: argparse.Namespace) -> int:
         "time_range": args.time_range,
         "bounds_factor": args.bounds_factor,
         "seed": args.seed,
+        "fit_offset": args.fit_offset,
         "output": args.output,
         "report": not args.no_report,
     }
@@ -121,6 +128,12 @@ def main(args: argparse.Namespace) -> int:
             )
         else:
             print(f"  {name:>16}   NOT IDENTIFIED: 95% {lo:.4g} .. {hi:.4g} {unit} (best {value:.4g})")
+    if result.offset is not None and result.offset_interval is not None:
+        lo, hi = result.offset_interval
+        print(
+            f"  {'load-cell offset':>16} = {result.offset:.4g} +- {result.offset_uncertainty:.2g} N "
+            f"(95% {lo:.4g} .. {hi:.4g}; what the load cell reads at zero force)"
+        )
     print(
         f"fit error: RMSE {result.rmse:.6g} N against noise level {result.noise:.6g} N "
         f"(ratio {result.rmse / result.noise:.3g}), r^2 {result.r2:.6f}, max {result.max_error:.6g} N"
@@ -142,6 +155,7 @@ def _batch(args: argparse.Namespace, bags: list) -> int:
         "time_range": args.time_range,
         "bounds_factor": args.bounds_factor,
         "seed": args.seed,
+        "fit_offset": args.fit_offset,
         "report": not args.no_report,
     }
     return batch_main(
