@@ -113,3 +113,41 @@ def test_a_contact_at_rest_commanded_to_its_own_depth_snaps_in(preset: str) -> N
     assert batch["contact_radius"][1] == first.contact_radius
     stepped.reset(0.0)
     assert stepped.step(0.0, depth=0.0).force == first.force
+
+
+def _elastic_closed_form() -> ContactSimulator:
+    from viscoadh_ros.core.config import SceneConfig
+
+    scene = {
+        "contacts": ["c"],
+        "c": {
+            "indenter": {"shape": "sphere", "radius": 0.01},
+            "material": {"glass_shear_modulus": 1.0e6, "poisson_ratio": 0.5},
+            "adhesion": {"work_of_adhesion": 0.05},
+        },
+    }
+    simulator = ContactSimulator(SceneConfig.from_dict(scene).contact("c"))
+    assert not isinstance(simulator._model, _TimeStepped)  # `model: auto` took the closed form
+    return simulator
+
+
+def test_a_repeated_sample_on_the_closed_form_and_from_any_number_type() -> None:
+    """The closed form (an elastic body, `model: auto`) and the general `step` path (times
+    that are ints or numpy scalars, which the lean path leaves to it) repeat a step too, and
+    `step_depths` (which runs the closed form row by row) agrees with `step` on every field
+    (the second tester: phase INDENTING against DETACHING, edge speed 0 on a repeated row)."""
+    t, d = _history()
+    batch = _elastic_closed_form().step_depths(np.repeat(t, 2), np.repeat(d, 2))
+    stepped = _elastic_closed_form()
+    for index, (ti, di) in enumerate(zip(t, d, strict=True)):
+        first = stepped.step(float(ti), depth=float(di))
+        assert stepped.step(float(ti), depth=float(di)) == first
+        for name in ("force", "contact_radius", "phase", "edge_speed", "scale_separation_ok"):
+            want = getattr(first, name)
+            assert batch[name][2 * index] == want and batch[name][2 * index + 1] == want, (index, name)
+    for make in (_elastic_closed_form, lambda: _simulator("fast")):
+        simulator = make()
+        for index, di in enumerate(d[:120]):
+            first = simulator.step(index + 1, depth=float(di))  # whole seconds, an int time
+            assert simulator.step(np.int64(index + 1), depth=np.float64(di)) == first
+            assert simulator.step(index + 1, depth=float(di)) == first

@@ -2001,10 +2001,14 @@ class ContactSimulator:
             raise InputError("step needs exactly one of depth or force")
         if depth is not None:
             d = require_finite("depth", depth)
+            if t == self._time and self._repeats(d, None):
+                return self._output  # `step`'s repeated sample, for any number type and model
             output = self._move(t, d, unstable=False)
             self._held_force = None
             return output
         target = require_finite("force", force)
+        if t == self._time and self._repeats(None, target):
+            return self._output
         output = self._solve_force(t, target)
         self._held_force = target
         return output
