@@ -2927,6 +2927,73 @@ def _advance_from(
     cover the whole row, updated every element in every later substep of its step (the edge
     racing on after the jump: ~N/16 substeps at N elements, O(N) each; issue 13, 0.6.0).
     """
+    row = (
+        wl,
+        wsum,
+        wb,
+        bsum,
+        scratch,
+        scratch_b,
+        diss,
+        coef,
+        dx,
+        g_c,
+        gf,
+        gint,
+        gmin,
+        gmax,
+        df,
+        e0,
+        c_crit,
+        reach,
+        p,
+        p_inv,
+        lam,
+        beta,
+        rate,
+        kap,
+        e_kelvin,
+        out,
+    )
+    return _advance_body(row, a, d0, d1, dt, max_substep, max_edge_move, force_prev, backup, backup_b)
+
+
+# Inlined (numba's IR inlining) into `_advance_from` and into `_advance_rows`'s row loop: called,
+# each row passed the kernel's 26 arrays and scalars (7-9 words an array, ~180 words on the
+# stack) and the callee spilled and reloaded them, ~550 instructions of a K = 0 row of ~3000
+# (0.11.0 `rest`). Its arguments as one tuple: CPython compiles a call of more than 30
+# arguments as ``f(*args)``, which numba's inliner does not take.
+@numba.njit(nogil=True, _nrt=False, inline="always")
+def _advance_body(row, a, d0, d1, dt, max_substep, max_edge_move, force_prev, backup, backup_b):
+    """`_advance_from`'s body; ``row``: its first 26 arguments (`Row.kernel_args`)."""
+    (
+        wl,
+        wsum,
+        wb,
+        bsum,
+        scratch,
+        scratch_b,
+        diss,
+        coef,
+        dx,
+        g_c,
+        gf,
+        gint,
+        gmin,
+        gmax,
+        df,
+        e0,
+        c_crit,
+        reach,
+        p,
+        p_inv,
+        lam,
+        beta,
+        rate,
+        kap,
+        e_kelvin,
+        out,
+    ) = row
     n, k_count = wl.shape
     keep = backup.shape[0] == n
     h_min = dt * JUMP_RESOLUTION
@@ -3517,33 +3584,35 @@ def _advance_rows(
         d1 = depths[i]
         if a <= 0.0 and peak <= idle_limit and d1 < 0.0 and d_prev < 0.0:
             return i, STATUS_IDLE
-        status = _advance_from(
-            wl,
-            wsum,
-            wb,
-            bsum,
-            scratch,
-            scratch_b,
-            diss,
-            coef,
-            dx,
-            g_c,
-            gf,
-            gint,
-            gmin,
-            gmax,
-            df,
-            e0,
-            c_crit,
-            reach,
-            p,
-            p_inv,
-            lam,
-            beta,
-            rate,
-            kap,
-            e_kelvin,
-            out,
+        status = _advance_body(
+            (
+                wl,
+                wsum,
+                wb,
+                bsum,
+                scratch,
+                scratch_b,
+                diss,
+                coef,
+                dx,
+                g_c,
+                gf,
+                gint,
+                gmin,
+                gmax,
+                df,
+                e0,
+                c_crit,
+                reach,
+                p,
+                p_inv,
+                lam,
+                beta,
+                rate,
+                kap,
+                e_kelvin,
+                out,
+            ),
             a,
             d_prev,
             d1,
