@@ -1,7 +1,8 @@
 """Where a `step_depths` row goes beyond the kernel (issue 13, 0.11.0 `rest`): on the kernel
 section's state (`row_rest.bench_state`), interleaved in one process, thread CPU time, us a row
 of 400: `simulator.restore` + `step_depths` (the bench's batch column), `restore` alone, and
-`_advance_rows` alone; "python" is the batch less the kernel.
+`_advance_rows` alone, and `MinimalStepper.run` over the same rows from the same state (the
+bench's baseline); "python" is the batch less the kernel.
 
     PYTHONPATH=. .venv/bin/python benchmarks/step_depths_split.py 64,0 1024,0 64,1 1024,1
 """
@@ -14,6 +15,7 @@ import numpy as np
 sys.path.insert(0, str(__import__("pathlib").Path(__file__).resolve().parent))
 from row_rest import bench_state
 
+from viscoadh_ros.bench.reference_stepper import MinimalStepper
 from viscoadh_ros.core import _kernels
 
 
@@ -43,7 +45,13 @@ def split(nk: str) -> None:
             *row.kernel_args, bk, bkb, radius, t0, d0, peak, times, depths, 0, ms, mm, 0.0, rows
         )
 
-    runs = {"batch": batch, "restore": restore, "kernel": kernel}
+    minimal_stepper = MinimalStepper.on_grid_of(sim)
+
+    def minimal():
+        minimal_stepper.set_state(depth=d0, radius=radius, memory=wl0)
+        minimal_stepper.run(1e-3, depths)
+
+    runs = {"batch": batch, "restore": restore, "kernel": kernel, "minimal": minimal}
     for r in runs.values():
         r()
     samples = {name: [] for name in runs}
@@ -57,6 +65,8 @@ def split(nk: str) -> None:
         nk,
         " ".join(f"{k} {v:.3f}" for k, v in med.items()),
         f"python {med['batch'] - med['kernel']:.3f} us/row",
+        f"batch/minimal {med['batch'] / med['minimal']:.2f}",
+        f"kernel/minimal {med['kernel'] / med['minimal']:.2f}",
     )
 
 
