@@ -39,8 +39,8 @@ def _model(material: dict, elements: int):
 
 
 def _counted_step(row: _kernels.Row, a: float, d0: float, d1: float, dt: float, max_edge_move: float):
-    """`_kernels.advance` through `_advance_from`'s Python body, its element updates counted:
-    ``(status, out, updates)``."""
+    """`_kernels.advance` through `_advance_from`'s Python body (`_advance_body`), its element
+    updates counted: ``(status, out, updates)``."""
     updates = [0]
     saved = {name: getattr(_kernels, name) for name in ("_update_range", "_catch_up")}
 
@@ -59,8 +59,9 @@ def _counted_step(row: _kernels.Row, a: float, d0: float, d1: float, dt: float, 
     _kernels._update_range = update_range
     _kernels._catch_up = catch_up
     try:
-        status = _kernels._advance_from.py_func(
-            *args, a, d0, d1, dt, 0.0, max_edge_move, force_prev, wl[:0], wb[:0]
+        # `_advance_from`'s body (`_advance_body`, 0.11.0: inlined where it is compiled).
+        status = _kernels._advance_body.py_func(
+            tuple(args), a, d0, d1, dt, 0.0, max_edge_move, force_prev, wl[:0], wb[:0]
         )
     finally:
         for name, kernel in saved.items():

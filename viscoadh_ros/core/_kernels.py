@@ -889,7 +889,7 @@ def _deviation_integral(a, d, wsum, bsum, n_in, dx, g_c, gf, gint, df, kap, buf)
     return total
 
 
-@numba.njit(cache=True, nogil=True, _nrt=False)
+@numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
 def _force(a, d, wsum, bsum, dx, g_c, gf, gint, df, e0, kap, buf):
     """Normal force ``F = 2 E0* int_0^a (u - w) dx = 2 E0* ((1-kap) int u - int dev)``, N,
     with ``dev = w - kap u`` the memory's deviation from relaxed (zero when relaxed, so
@@ -1440,7 +1440,7 @@ def _update_range_one(
     return total + ((s0 + s1) + (s2 + s3)), max(max(p0, p1), max(p2, p3))
 
 
-@numba.njit(cache=True, nogil=True, _nrt=False)
+@numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
 def _update_range(
     wl,
     wsum,
@@ -2433,7 +2433,7 @@ def _restore_state(wl, wsum, wb, bsum, src, src_b):
     _restore_range(wl, wsum, wb, bsum, src, src_b, 0, wl.shape[0])
 
 
-@numba.njit(cache=True, nogil=True, _nrt=False)
+@numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
 def _edge_outputs(a, d, wsum, bsum, dx, g_c, gf, df, c_crit, out):
     """Write the edge gaps on both sides and g at the edge into ``out`` (zeros without contact)."""
     if a > 0.0:
@@ -2927,6 +2927,73 @@ def _advance_from(
     cover the whole row, updated every element in every later substep of its step (the edge
     racing on after the jump: ~N/16 substeps at N elements, O(N) each; issue 13, 0.6.0).
     """
+    row = (
+        wl,
+        wsum,
+        wb,
+        bsum,
+        scratch,
+        scratch_b,
+        diss,
+        coef,
+        dx,
+        g_c,
+        gf,
+        gint,
+        gmin,
+        gmax,
+        df,
+        e0,
+        c_crit,
+        reach,
+        p,
+        p_inv,
+        lam,
+        beta,
+        rate,
+        kap,
+        e_kelvin,
+        out,
+    )
+    return _advance_body(row, a, d0, d1, dt, max_substep, max_edge_move, force_prev, backup, backup_b)
+
+
+# Inlined (numba's IR inlining) into `_advance_from` and into `_advance_rows`'s row loop: called,
+# each row passed the kernel's 26 arrays and scalars (7-9 words an array, ~180 words on the
+# stack) and the callee spilled and reloaded them, ~550 instructions of a K = 0 row of ~3000
+# (0.11.0 `rest`). Its arguments as one tuple: CPython compiles a call of more than 30
+# arguments as ``f(*args)``, which numba's inliner does not take.
+@numba.njit(nogil=True, _nrt=False, inline="always")
+def _advance_body(row, a, d0, d1, dt, max_substep, max_edge_move, force_prev, backup, backup_b):
+    """`_advance_from`'s body; ``row``: its first 26 arguments (`Row.kernel_args`)."""
+    (
+        wl,
+        wsum,
+        wb,
+        bsum,
+        scratch,
+        scratch_b,
+        diss,
+        coef,
+        dx,
+        g_c,
+        gf,
+        gint,
+        gmin,
+        gmax,
+        df,
+        e0,
+        c_crit,
+        reach,
+        p,
+        p_inv,
+        lam,
+        beta,
+        rate,
+        kap,
+        e_kelvin,
+        out,
+    ) = row
     n, k_count = wl.shape
     keep = backup.shape[0] == n
     h_min = dt * JUMP_RESOLUTION
@@ -2980,33 +3047,35 @@ def _advance_from(
         n0 = _interior_count(a, dx, n)
         n1 = _interior_count(new_a, dx, n)
         _copy_range(wl, wb, scratch, scratch_b, min(n0, n1), max(n0, n1))
-        hysteresis = _retime_crossed(
-            wl,
-            wsum,
-            wb,
-            bsum,
-            scratch,
-            scratch_b,
-            diss,
-            coef,
-            a,
-            new_a,
-            d1,
-            d1,
-            0.0,
-            dx,
-            g_c,
-            p,
-            p_inv,
-            lam,
-            beta,
-            rate,
-            e_kelvin,
-            e0,
-            c_crit,
-            gf,
-            df,
-        )
+        hysteresis = 0.0
+        if n1 != n0:  # (else `_retime_crossed` returns 0, as in the substep loop)
+            hysteresis = _retime_crossed(
+                wl,
+                wsum,
+                wb,
+                bsum,
+                scratch,
+                scratch_b,
+                diss,
+                coef,
+                a,
+                new_a,
+                d1,
+                d1,
+                0.0,
+                dx,
+                g_c,
+                p,
+                p_inv,
+                lam,
+                beta,
+                rate,
+                e_kelvin,
+                e0,
+                c_crit,
+                gf,
+                df,
+            )
         force_new = _force(new_a, d1, wsum, bsum, dx, g_c, gf, gint, df, e0, kap, diss)
         out[OUT_RADIUS] = new_a
         out[OUT_FORCE] = force_new
@@ -3204,33 +3273,37 @@ def _advance_from(
                 0.0,
                 False,
             )
-        hysteresis = _retime_crossed(
-            wl,
-            wsum,
-            wb,
-            bsum,
-            scratch,
-            scratch_b,
-            diss,
-            coef,
-            a,
-            new_a,
-            da,
-            db,
-            h,
-            dx,
-            g_c,
-            p,
-            p_inv,
-            lam,
-            beta,
-            rate,
-            e_kelvin,
-            e0,
-            c_crit,
-            gf,
-            df,
-        )
+        # `_retime_crossed` returns 0 and changes nothing when the edge crossed no element
+        # centre: not called then (its 25 arguments cost ~280 instructions of a row, 0.11.0).
+        hysteresis = 0.0
+        if _interior_count(new_a, dx, n) != n_in:
+            hysteresis = _retime_crossed(
+                wl,
+                wsum,
+                wb,
+                bsum,
+                scratch,
+                scratch_b,
+                diss,
+                coef,
+                a,
+                new_a,
+                da,
+                db,
+                h,
+                dx,
+                g_c,
+                p,
+                p_inv,
+                lam,
+                beta,
+                rate,
+                e_kelvin,
+                e0,
+                c_crit,
+                gf,
+                df,
+            )
         if k_count:
             # ... the window (retimed where the edge crossed), then the elements after it.
             for i in range(_u(lo), _u(hi)):
@@ -3538,33 +3611,35 @@ def _advance_rows(
         d1 = depths[i]
         if a <= 0.0 and peak <= idle_limit and d1 < 0.0 and d_prev < 0.0:
             return i, STATUS_IDLE
-        status = _advance_from(
-            wl,
-            wsum,
-            wb,
-            bsum,
-            scratch,
-            scratch_b,
-            diss,
-            coef,
-            dx,
-            g_c,
-            gf,
-            gint,
-            gmin,
-            gmax,
-            df,
-            e0,
-            c_crit,
-            reach,
-            p,
-            p_inv,
-            lam,
-            beta,
-            rate,
-            kap,
-            e_kelvin,
-            out,
+        status = _advance_body(
+            (
+                wl,
+                wsum,
+                wb,
+                bsum,
+                scratch,
+                scratch_b,
+                diss,
+                coef,
+                dx,
+                g_c,
+                gf,
+                gint,
+                gmin,
+                gmax,
+                df,
+                e0,
+                c_crit,
+                reach,
+                p,
+                p_inv,
+                lam,
+                beta,
+                rate,
+                kap,
+                e_kelvin,
+                out,
+            ),
             a,
             d_prev,
             d1,
@@ -4180,6 +4255,88 @@ def _step_packed(
         effective,
         separated,
     )
+
+
+@numba.njit(cache=True, nogil=True)
+def _batch_columns(
+    d, steps, radius, gaps, rest, work, r0, energy0, c_crit, e_relaxed, v_c1, v_c2, force, dissipated, first
+):
+    """`ContactSimulator.step_depths`'s derived columns in one compiled pass: ``(phase (uint8),
+    edge_speed, effective_work_of_adhesion, energy_input, scale_separation_ok)`` per row from the
+    depths ``d``, the time steps ``steps`` (s), the kernel's radius, edge gaps ``gaps`` (n, 3) and
+    edge resolutions ``rest`` per row, its work per row, the radius before the first row ``r0``
+    and the energy input before it ``energy0``.
+
+    Each element the same IEEE operations in the same order as the numpy expressions it
+    replaces (and as `_step_packed` per call): the same bits. The energy input is the running
+    sum in row order, as ``np.cumsum`` takes it. Those ~25 array operations on a 400-row call
+    cost about as much as the kernel's rows at N = 64 (0.11.0 `rest`).
+
+    A repeated sample (`ContactSimulator._repeats`: no time, the depth of the row before, which
+    is not a contact at rest) takes the row before's phase, edge speed, effective work and
+    scale separation, as `step` returns the step before. ``force`` and ``dissipated`` per row
+    tell rest from a step; ``first`` = (depth before the first row, whether the state before it
+    may be repeated (1.0/0.0), its phase code, edge speed, effective work and scale
+    separation (1.0/0.0)): the simulator's output before the call."""
+    n = d.shape[0]
+    phase = np.empty(n, np.uint8)
+    edge_speed = np.empty(n)
+    effective = np.empty(n)
+    energy = np.empty(n)
+    ok = np.empty(n, np.bool_)
+    before = r0
+    total = energy0
+    d_before = first[0]
+    repeatable = first[1] != 0.0
+    code_before = np.uint8(first[2])
+    speed_before = first[3]
+    effective_before = first[4]
+    ok_before = first[5] != 0.0
+    for i in range(n):
+        radius_i = radius[i]
+        if steps[i] == 0.0 and d[i] == d_before and repeatable:
+            phase[i] = code_before
+            edge_speed[i] = speed_before
+            effective[i] = effective_before
+            ok[i] = ok_before
+            total = total + work[i]
+            energy[i] = total
+            before = radius_i
+            continue
+        g = gaps[i, 2]
+        if radius_i <= 0.0:
+            code = PHASE_NO_CONTACT
+        elif radius_i > before + rest[i]:
+            code = PHASE_INDENTING
+        elif radius_i < before - rest[i]:
+            code = PHASE_DETACHING
+        else:
+            tol = 1e-9 * (abs(d[i]) + c_crit * math.sqrt(radius_i) + g)
+            if gaps[i, 0] >= -tol:
+                code = PHASE_INDENTING
+            elif gaps[i, 1] <= tol:
+                code = PHASE_DETACHING
+            else:
+                code = PHASE_STICKING
+        phase[i] = code
+        speed = (radius_i - before) / steps[i] if steps[i] > 0.0 else 0.0
+        edge_speed[i] = speed
+        u = d[i] - g
+        if radius_i > 0.0 and u < 0.0:
+            effective[i] = e_relaxed * u * u / (2.0 * math.pi * radius_i)
+        else:
+            effective[i] = 0.0
+        ok[i] = speed == 0.0 or abs(speed) >= (v_c1 if speed > 0.0 else v_c2)
+        total = total + work[i]
+        energy[i] = total
+        before = radius_i
+        d_before = d[i]
+        repeatable = not (radius_i == 0.0 and force[i] == 0.0 and total == 0.0 and dissipated[i] == 0.0)
+        code_before = code
+        speed_before = speed
+        effective_before = effective[i]
+        ok_before = ok[i]
+    return phase, edge_speed, effective, energy, ok
 
 
 #: `_step_packed`'s argument types: its one compiled version, whose entry point

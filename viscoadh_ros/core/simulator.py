@@ -2072,55 +2072,45 @@ class ContactSimulator:
         physics = self.physics
         # `rest`: per row, the edge resolution of the row that stepped it (the row after the
         # batch may be another one, or none: a batch that ended idle read every edge at rest
-        # as moving, INDENTING and DETACHING in turn).
-        r0 = np.concatenate(([self._output.contact_radius], radius[:-1]))
-        dt = steps
-        energy_input = np.cumsum(np.concatenate(([self._energy_input], work)))[1:]
+        # as moving, INDENTING and DETACHING in turn). The phase (`_phase` on columns, g at the
+        # edge as the kernel saw it: 0 without contact, like `step`), edge speed, effective work
+        # of adhesion, scale separation and the running energy input in one compiled pass
+        # (`_kernels._batch_columns`: the numpy expressions' operations, the same bits).
+        # A repeated sample (`step`'s `_repeats`: the same depth at the same instant after a
+        # depth step, not from rest) publishes the step before it as it was (the kernel left
+        # the state alone): `_batch_columns` copies that row's derived columns.
+        v_c1, v_c2 = physics.critical_speeds
+        before = self._output
+        first = np.array(
+            [
+                self._depth,
+                float(self._held_force is None and not _rest_like(before)),
+                float(int(before.phase)),
+                before.edge_speed,
+                before.effective_work_of_adhesion,
+                float(bool(before.scale_separation_ok)),
+            ]
+        )
+        phase, edge_speed, effective, energy_input, ok = _kernels._batch_columns(
+            d,
+            steps,
+            radius,
+            gaps,
+            rest,
+            work,
+            before.contact_radius,
+            self._energy_input,
+            physics.c_crit,
+            physics.e_relaxed,
+            v_c1,
+            v_c2,
+            force,
+            dissipated,
+            first,
+        )
         bad = np.flatnonzero(~(np.isfinite(energy_input) & np.isfinite(dissipated)))
         if bad.size:
             raise _overflow(float(energy_input[bad[0]]), float(dissipated[bad[0]]))
-        # `_phase` on columns. g at the edge as the kernel saw it (0 without contact), like `step`.
-        g = gaps[:, 2]
-        tol = 1e-9 * (np.abs(d) + physics.c_crit * np.sqrt(radius) + g)
-        pinned = np.where(
-            gaps[:, 0] >= -tol, Phase.INDENTING, np.where(gaps[:, 1] <= tol, Phase.DETACHING, Phase.STICKING)
-        )
-        phase = np.where(
-            radius <= 0.0,
-            Phase.NO_CONTACT,
-            np.where(
-                radius > r0 + rest, Phase.INDENTING, np.where(radius < r0 - rest, Phase.DETACHING, pinned)
-            ),
-        ).astype(np.uint8)
-        moving = dt > 0.0
-        edge_speed = np.where(moving, (radius - r0) / np.where(moving, dt, 1.0), 0.0)
-        u = d - g
-        in_contact = radius > 0.0
-        effective = np.where(
-            in_contact & (u < 0.0),
-            physics.e_relaxed * u * u / (2.0 * math.pi * np.where(in_contact, radius, 1.0)),
-            0.0,
-        )
-        v_c1, v_c2 = physics.critical_speeds
-        ok = (edge_speed == 0.0) | (np.abs(edge_speed) >= np.where(edge_speed > 0.0, v_c1, v_c2))
-        # A repeated sample (`step`'s `_repeats`: the same depth at the same instant after a
-        # depth step, not from rest) publishes the step before it as it was; the kernel left
-        # the state alone.
-        before = self._output
-        rest_like = (radius == 0.0) & (force == 0.0) & (energy_input == 0.0) & (dissipated == 0.0)
-        rest_like = np.concatenate(([_rest_like(before)], rest_like[:-1]))
-        repeated = (dt == 0.0) & (d == np.concatenate(([self._depth], d[:-1]))) & ~rest_like
-        repeated[0] &= self._held_force is None
-        if repeated.any():
-            rows = np.arange(t.size)
-            source = np.maximum.accumulate(np.where(repeated, -1, rows))
-            for values, first in (
-                (phase, int(before.phase)),
-                (edge_speed, before.edge_speed),
-                (effective, before.effective_work_of_adhesion),
-                (ok, before.scale_separation_ok),
-            ):
-                values[repeated] = np.where(source >= 0, values[np.maximum(source, 0)], first)[repeated]
         columns = {
             "time": t,
             "depth": d,
