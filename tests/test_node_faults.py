@@ -427,3 +427,36 @@ def test_a_hold_that_fails_keeps_the_state_and_the_timer_and_the_next_command_is
     finally:
         with contact.lock:
             del contact.simulator.step
+
+
+def test_a_max_substep_too_fine_for_a_step_rejects_the_command_and_the_node_keeps_serving(
+    ros_context: Any, ros_executor: Any, spin_until: Any
+) -> None:
+    """0.10.0's outside tester: `max_substep: 1e-12` set at runtime on the idle contact (accepted:
+    the scene alone cannot know the steps), then two commands 10 ms apart: the second never got
+    an answer, the other contact and the services stopped answering and SIGTERM could not stop
+    the node (one step of 1e10 substeps). Now the second command is rejected naming the fix,
+    the contact kept as its twin, and the node serves everything else. Numbers outside a
+    numerics range are refused as parameters, as from a scene file."""
+    node = _node(ros_context, ros_executor)
+    bad = node.set_parameters([Parameter("visco.numerics.elements", value=100_000_000)])[0]
+    assert not bad.successful
+    bad = node.set_parameters([Parameter("visco.numerics.domain_radius", value=1e300)])[0]
+    assert not bad.successful
+    fine = node.set_parameters([Parameter("visco.numerics.max_substep", value=1e-12)])[0]
+    assert fine.successful, fine.reason
+    client = EventClient(ros_context, ros_executor, spin_until, contact="visco")
+    fine_scene = SceneConfig.from_parameters({**FAULT_SCENE, "visco.numerics.max_substep": 1e-12})
+    twin = ContactSimulator(fine_scene.contact("visco"))
+    first = client.send(_command(client.t0, depth=5e-6))
+    assert first is not None and first.force == twin.step(0.0, depth=5e-6).force
+    assert client.send(_command(client.t0 + 10_000_000, depth=6e-6), expect_state=False) is None
+    reason = client.rejected(1).reason
+    assert "numerics.max_substep" in reason and "at least 1e-06 s" in reason, reason
+    # Steps of at most 10000 substeps (10 ns here) are served, from the kept state.
+    after = client.send(_command(client.t0 + 5, depth=5.0e-6 + 1e-12))
+    assert after is not None and after.force == twin.step(5 * 1e-9, depth=5.0e-6 + 1e-12).force
+    other = EventClient(ros_context, ros_executor, spin_until, contact="elastic")
+    assert other.send(_command(other.t0, depth=5e-6)) is not None, "the other contact answers"
+    assert client.call(client.reset, Trigger.Request()).success, "the services answer"
+
