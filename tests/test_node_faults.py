@@ -460,3 +460,37 @@ def test_a_max_substep_too_fine_for_a_step_rejects_the_command_and_the_node_keep
     assert other.send(_command(other.t0, depth=5e-6)) is not None, "the other contact answers"
     assert client.call(client.reset, Trigger.Request()).success, "the services answer"
 
+
+def test_a_stop_does_not_wait_for_a_step_that_runs_on(
+    ros_context: Any, ros_executor: Any, spin_until: Any
+) -> None:
+    """SIGINT/SIGTERM end in `destroy_node`, which stopped the live thread and waited for it: a
+    step that did not end (0.10.0's max_substep 1e-12) kept the node running until kill -9.
+    Steps are bounded now, but a large scene's may take seconds: the stop waits at most
+    STOP_WAIT_S for it (the step, blocked here on cue, then ends on its own)."""
+    from viscoadh_ros.ros import node as node_module
+
+    node = _node(ros_context, ros_executor)
+    client = EventClient(ros_context, ros_executor, spin_until, contact="visco")
+    contact = node.contacts["visco"]
+    real_step = contact.simulator.step
+    entered, release = node_module.threading.Event(), node_module.threading.Event()
+
+    def long_step(time: float, **control: float) -> Any:
+        entered.set()
+        release.wait(60.0)
+        return real_step(time, **control)
+
+    contact.simulator.step = long_step
+    try:
+        client.pub.publish(_command(client.t0, depth=5e-6))
+        assert spin_until(ros_executor, entered.is_set, TIMEOUT), "the command reached no step"
+        assert not node._live.stop(0.0), "the live thread is in the step"
+        ros_executor.remove_node(node)
+        node.destroy_node()  # returns though the step runs on
+        assert node._live._thread.is_alive()
+    finally:
+        release.set()
+    node._live._thread.join(60.0)
+    assert not node._live._thread.is_alive(), "the step ended and the thread with it"
+    assert node._live.error is None, "a stop is not a live-path failure"
