@@ -427,3 +427,70 @@ def test_a_hold_that_fails_keeps_the_state_and_the_timer_and_the_next_command_is
     finally:
         with contact.lock:
             del contact.simulator.step
+
+
+def test_a_max_substep_too_fine_for_a_step_rejects_the_command_and_the_node_keeps_serving(
+    ros_context: Any, ros_executor: Any, spin_until: Any
+) -> None:
+    """0.10.0's outside tester: `max_substep: 1e-12` set at runtime on the idle contact (accepted:
+    the scene alone cannot know the steps), then two commands 10 ms apart: the second never got
+    an answer, the other contact and the services stopped answering and SIGTERM could not stop
+    the node (one step of 1e10 substeps). Now the second command is rejected naming the fix,
+    the contact kept as its twin, and the node serves everything else. Numbers outside a
+    numerics range are refused as parameters, as from a scene file."""
+    node = _node(ros_context, ros_executor)
+    bad = node.set_parameters([Parameter("visco.numerics.elements", value=100_000_000)])[0]
+    assert not bad.successful
+    bad = node.set_parameters([Parameter("visco.numerics.domain_radius", value=1e300)])[0]
+    assert not bad.successful
+    fine = node.set_parameters([Parameter("visco.numerics.max_substep", value=1e-12)])[0]
+    assert fine.successful, fine.reason
+    client = EventClient(ros_context, ros_executor, spin_until, contact="visco")
+    fine_scene = SceneConfig.from_parameters({**FAULT_SCENE, "visco.numerics.max_substep": 1e-12})
+    twin = ContactSimulator(fine_scene.contact("visco"))
+    first = client.send(_command(client.t0, depth=5e-6))
+    assert first is not None and first.force == twin.step(0.0, depth=5e-6).force
+    assert client.send(_command(client.t0 + 10_000_000, depth=6e-6), expect_state=False) is None
+    reason = client.rejected(1).reason
+    assert "numerics.max_substep" in reason and "at least 1e-06 s" in reason, reason
+    # Steps of at most 10000 substeps (10 ns here) are served, from the kept state.
+    after = client.send(_command(client.t0 + 5, depth=5.0e-6 + 1e-12))
+    assert after is not None and after.force == twin.step(5 * 1e-9, depth=5.0e-6 + 1e-12).force
+    other = EventClient(ros_context, ros_executor, spin_until, contact="elastic")
+    assert other.send(_command(other.t0, depth=5e-6)) is not None, "the other contact answers"
+    assert client.call(client.reset, Trigger.Request()).success, "the services answer"
+
+
+def test_a_stop_does_not_wait_for_a_step_that_runs_on(
+    ros_context: Any, ros_executor: Any, spin_until: Any
+) -> None:
+    """SIGINT/SIGTERM end in `destroy_node`, which stopped the live thread and waited for it: a
+    step that did not end (0.10.0's max_substep 1e-12) kept the node running until kill -9.
+    Steps are bounded now, but a large scene's may take seconds: the stop waits at most
+    STOP_WAIT_S for it (the step, blocked here on cue, then ends on its own)."""
+    from viscoadh_ros.ros import node as node_module
+
+    node = _node(ros_context, ros_executor)
+    client = EventClient(ros_context, ros_executor, spin_until, contact="visco")
+    contact = node.contacts["visco"]
+    real_step = contact.simulator.step
+    entered, release = node_module.threading.Event(), node_module.threading.Event()
+
+    def long_step(time: float, **control: float) -> Any:
+        entered.set()
+        release.wait(60.0)
+        return real_step(time, **control)
+
+    contact.simulator.step = long_step
+    try:
+        client.pub.publish(_command(client.t0, depth=5e-6))
+        assert spin_until(ros_executor, entered.is_set, TIMEOUT), "the command reached no step"
+        assert not node._live.stop(0.0), "the live thread is in the step"
+        ros_executor.remove_node(node)
+        node.destroy_node()  # returns though the step runs on
+        assert node._live._thread.is_alive()
+    finally:
+        release.set()
+    node._live._thread.join(60.0)
+    assert not node._live._thread.is_alive(), "the step ended and the thread with it"
+    assert node._live.error is None, "a stop is not a live-path failure"

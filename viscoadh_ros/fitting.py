@@ -561,7 +561,7 @@ def fit_grid(
     at the record's deepest point, with the preset's elements scaled up (at most
     :data:`MAX_ELEMENT_FACTOR` times) so the start's contact keeps its resolution."""
     from viscoadh_ros.core.criterion import critical_glass_elongation
-    from viscoadh_ros.core.presets import resolve_numerics
+    from viscoadh_ros.core.presets import DOMAIN_RADIUS_RANGE, ELEMENTS_MAX, resolve_numerics
     from viscoadh_ros.core.profiles import make_profile
     from viscoadh_ros.core.rheology import CreepElement
 
@@ -592,7 +592,10 @@ def fit_grid(
     largest, at_start = reach(g0_lo, w_hi), reach(g0, w)
     elements = resolve_numerics(contact.numerics).elements
     factor = min(max(largest / at_start, 1.0), MAX_ELEMENT_FACTOR)
-    return GRID_MARGIN * largest, int(math.ceil(elements * factor))
+    # Within the ranges a scene may give (presets.DOMAIN_RADIUS_RANGE, ELEMENTS_MAX): a contact
+    # that outgrows the domain grows it, so the upper bound costs only speed.
+    domain = min(max(GRID_MARGIN * largest, DOMAIN_RADIUS_RANGE[0]), DOMAIN_RADIUS_RANGE[1])
+    return domain, min(int(math.ceil(elements * factor)), ELEMENTS_MAX)
 
 
 class _Problem:
@@ -794,7 +797,13 @@ def polish_elements(contact: ContactConfig, noise: float, force_scale: float, co
     never fewer than ``coarse``. A tolerance tighter than the ladder can meet takes its last
     rung."""
     from viscoadh_ros.core.errors import ConfigError
-    from viscoadh_ros.core.presets import ELEMENT_LADDER, SceneHint, numerics_for_tolerance, resolve_numerics
+    from viscoadh_ros.core.presets import (
+        ELEMENT_LADDER,
+        ELEMENTS_MAX,
+        SceneHint,
+        numerics_for_tolerance,
+        resolve_numerics,
+    )
 
     tolerance = min(MODEL_ERROR_FRACTION * noise / max(force_scale, 1e-300), 0.5)
     hint = SceneHint.of(contact.indenter, contact.material)
@@ -805,7 +814,7 @@ def polish_elements(contact: ContactConfig, noise: float, force_scale: float, co
     preset_numerics = dataclasses.replace(contact.numerics, elements=0, tolerance=0.0)
     preset_elements = resolve_numerics(preset_numerics).elements
     factor = coarse / preset_elements
-    return max(coarse, int(math.ceil(chosen * max(factor, 1.0))))
+    return min(max(coarse, int(math.ceil(chosen * max(factor, 1.0)))), ELEMENTS_MAX)
 
 
 def _identify_checks(

@@ -31,18 +31,19 @@ run while the contact stays inside it (it grows by `growth_factor` only when the
 reaches its end); the sub-element edge keeps the force continuous in every parameter.
 
 Knobs:
-- elements: N, elements of the 1D MDR row over the domain (0, L].
+- elements: N, elements of the 1D MDR row over the domain (0, L]; 4..ELEMENTS_MAX.
 - fine_factor: fine profile grid points per element (the edge root and force integral use
   the profile on that grid, so it only has to resolve g, not the memory).
 - max_edge_cells: a substep is halved while the edge would move more than this many
   elements in it (the memory of cells the edge crosses within one substep is updated with
   the contact set of the substep's start).
 - max_substep: upper bound on a substep, s; 0 = none (the Kelvin update is exact for any
-  step, so only the edge motion limits the step).
+  step, so only the edge motion limits the step). A step may take at most MAX_SUBSTEPS of
+  them: a longer step is refused.
 - force_tolerance: relative tolerance of the depth search under force control, scaled by
   the larger of |commanded force| and the force scale of the scene.
 - domain_radius: domain length L, m; 0 = chosen from the scene; > 0 = one fixed grid (see
-  above; it grows only when the contact reaches L).
+  above; it grows only when the contact reaches L), in DOMAIN_RADIUS_RANGE.
 - growth_factor: the domain grows by this factor when the contact needs more room.
 - idle_tolerance: out of contact, memory below this fraction of the domain length counts
   as relaxed: the contact is idle, its memory is dropped and a step costs nothing.
@@ -91,6 +92,24 @@ _PRESETS = {
 }
 
 
+#: Largest ``numerics.elements``. The cost of a step grows with N (a snap-in's edge races across
+#: ~N/16 elements, one substep each; out of contact a substep reads the whole row): 65536
+#: elements ran a 21-row press and pull in 2 s (its snap-in 1.5 s), 262144 took 137 s, and
+#: 2e7 did not finish in 120 s (0.10.0's outside tester; 1e8 ran out of memory). The most any
+#: accuracy needs is far below: the tolerance ladder ends at 8192, a fit's grid at 4 x 8192.
+ELEMENTS_MAX = 65_536
+#: Range of ``numerics.domain_radius`` when given (> 0), m: from the smallest indenter radius
+#: (PHYSICAL_RANGES, core/config.py) to the longest first domain the scene may choose itself
+#: (`simulator.FIRST_DOMAIN_LIMIT`); 1e300 m overflowed the profile (a traceback).
+DOMAIN_RADIUS_RANGE = (1e-9, 1e3)
+#: Most substeps ``numerics.max_substep`` may cut one step into: the kernel's own finest
+#: substep is ``JUMP_RESOLUTION`` (1e-4) of the step, so a max_substep step costs at most
+#: what the kernel's own step control may; a step longer than ``MAX_SUBSTEPS x max_substep``
+#: is refused (InputError, `simulator.ContactSimulator.step`). Without it 1e-12 s cut a 10 ms
+#: step into 1e10 substeps and froze the node (0.10.0's outside tester).
+MAX_SUBSTEPS = 10_000
+
+
 def preset(name: str) -> ResolvedNumerics:
     """The numerics of preset `name` ("fast", "balanced" or "accurate")."""
     if name not in _PRESETS:
@@ -127,13 +146,20 @@ def resolve_numerics(numerics: Any) -> ResolvedNumerics:
     elements = getattr(numerics, "elements", 0)
     if isinstance(elements, bool) or not isinstance(elements, int) or elements < 0:
         raise ConfigError(f"numerics.elements must be an integer >= 0 (got {elements!r})")
-    if elements:
-        if elements < 4:
-            raise ConfigError(f"numerics.elements must be >= 4 or 0 for the preset (got {elements!r})")
+    if elements and not 4 <= elements <= ELEMENTS_MAX:
+        raise ConfigError(
+            f"numerics.elements must be 0 (the preset's) or in 4..{ELEMENTS_MAX} (got {elements!r})"
+        )
     for key in ("domain_radius", "max_substep", "force_tolerance"):
         number = _number(numerics, key)
         if number > 0.0:
             overrides[key] = number
+    low, high = DOMAIN_RADIUS_RANGE
+    if not low <= overrides.get("domain_radius", low) <= high:
+        raise ConfigError(
+            f"numerics.domain_radius must be 0 (chosen from the scene) or in [{low:g}, {high:g}] m "
+            f"(got {overrides['domain_radius']!r})"
+        )
     if overrides.get("force_tolerance", 0.0) >= 1.0:
         raise ConfigError(f"numerics.force_tolerance must be < 1 (got {overrides['force_tolerance']!r})")
     tolerance = check_tolerance(getattr(numerics, "tolerance", 0.0))

@@ -57,7 +57,7 @@ from . import _kernels
 from ._roots import brent_root
 from .criterion import critical_edge_speeds, critical_glass_elongation
 from .errors import ConfigError, InputError, require_finite
-from .presets import ResolvedNumerics, resolve_numerics
+from .presets import DOMAIN_RADIUS_RANGE, MAX_SUBSTEPS, ResolvedNumerics, resolve_numerics
 from .profiles import Profile, make_profile
 from .rheology import CreepElement
 
@@ -413,6 +413,10 @@ class _TimeStepped:
         # Read every kernel call (the numerics are frozen).
         self._max_substep = float(numerics.max_substep)
         self._max_edge_cells = float(numerics.max_edge_cells)
+        # The longest step the kernel may take, s: MAX_SUBSTEPS substeps of max_substep (inf
+        # without it). A longer step is refused before the kernel runs (`advance`, the lean
+        # paths of `ContactSimulator.step` leave it to `advance`).
+        self._longest_step = self._max_substep * MAX_SUBSTEPS if self._max_substep > 0.0 else math.inf
         # The compiled step (`_kernels._step_packed`) called through its entry point; loaded
         # (or compiled) with the first time-stepped model.
         global _STEP
@@ -803,6 +807,8 @@ class _TimeStepped:
                 return 0.0, 0.0, 0.0
             row = self.row
             assert row is not None
+        if dt > self._longest_step:
+            raise _too_many_substeps(dt, self._max_substep)
         # The first kernel call of the transaction on this row journals its memory into the
         # row's `txn` buffers (inside the compiled call, before the kernel writes anything)
         # instead of a snapshot of numpy copies. `_journal` is set just before that call: no
@@ -1171,8 +1177,9 @@ def _phase(model: Any, physics: _Physics, depth: float, r0: float, radius: float
 #: from it a step's slope is 0.46 to 1 times the glass stiffness on the bench's history).
 FOLD_SLOPE = 0.3
 
-#: The largest first domain (m) a time-stepped contact starts from (`_TimeStepped`).
-FIRST_DOMAIN_LIMIT = 1e3
+#: The largest first domain (m) a time-stepped contact starts from (`_TimeStepped`): the
+#: largest `numerics.domain_radius` a scene may give, too.
+FIRST_DOMAIN_LIMIT = DOMAIN_RADIUS_RANGE[1]
 
 #: The shortest time step (s) a step takes; a shorter one (other than none: a jump at one
 #: time) is refused. Below it the substep control halved steps to zero (a ZeroDivisionError
@@ -1205,6 +1212,17 @@ def _beyond_depth_limit(depth: float, limit: float) -> InputError:
     return InputError(
         f"depth {depth!r} m is beyond the scene's range: |depth| may be at most {limit:.3g} m, "
         "the largest domain this contact can represent (a force that needs it cannot be reached)"
+    )
+
+
+def _too_many_substeps(dt: float, max_substep: float) -> InputError:
+    """The error of a step of ``dt`` s that ``numerics.max_substep`` (s) would cut into more
+    than MAX_SUBSTEPS substeps (a max_substep of 1e-12 s froze the node on a 10 ms step)."""
+    return InputError(
+        f"a time step of {dt:.6g} s would take {dt / max_substep:.3g} substeps of numerics.max_substep "
+        f"{max_substep:g} s, more than the {MAX_SUBSTEPS} one step may take: step at most "
+        f"{MAX_SUBSTEPS * max_substep:.6g} s at a time, or set numerics.max_substep to at least "
+        f"{dt / MAX_SUBSTEPS:.6g} s (or 0: no bound)"
     )
 
 
@@ -1589,7 +1607,7 @@ class ContactSimulator:
             if (
                 t - t == 0.0
                 and abs(d) <= self._depth_limit
-                and (t == time0 or t - time0 >= MIN_TIME_STEP)
+                and (t == time0 or MIN_TIME_STEP <= t - time0 <= model._longest_step)
                 and not (d < 0.0 and d_prev < 0.0 and r0 <= 0.0 and model.is_relaxed())
             ):
                 row = model.row
@@ -1801,6 +1819,7 @@ class ContactSimulator:
             slope >= FOLD_SLOPE * glass
             and row is not None
             and getattr(model.advance, "__code__", None) is _ADVANCE_CODE
+            and t - self._time <= model._longest_step
         ):
             return None
         time0 = self._time
@@ -2064,8 +2083,12 @@ class ContactSimulator:
             )
         if t.size == 0:
             return _empty_columns()
-        if isinstance(self._model, _TimeStepped):
-            radius, force, work, dissipated, gaps, rest = self._model.advance_rows(self, t, d)
+        model = self._model
+        if isinstance(model, _TimeStepped):
+            long = np.flatnonzero(steps > model._longest_step)
+            if long.size:
+                return self._split_depths(t, d, long)
+            radius, force, work, dissipated, gaps, rest = model.advance_rows(self, t, d)
         else:
             outputs = [self._step(float(ti), float(di), None) for ti, di in zip(t, d, strict=True)]
             return _columns(outputs)
@@ -2133,6 +2156,24 @@ class ContactSimulator:
             *(columns[name][-1].item() for name in STEP_OUTPUT_FIELDS[5:]),
         )
         return columns
+
+    def _split_depths(self, t: np.ndarray, d: np.ndarray, long: np.ndarray) -> dict[str, np.ndarray]:
+        """`_step_depths` of rows of which those at ``long`` are steps longer than
+        MAX_SUBSTEPS x ``numerics.max_substep``: those rows stepped one by one (where the
+        contact is idle above the surface they cost nothing, else they are refused, naming
+        the row), the rows between them as batches."""
+        parts = []
+        start = 0
+        for k in (*(int(i) for i in long), t.size):
+            if k > start:
+                parts.append(self._step_depths(t[start:k], d[start:k]))
+            if k < t.size:
+                try:
+                    parts.append(_columns([self._step(float(t[k]), float(d[k]), None)]))
+                except InputError as error:
+                    raise InputError(f"time[{k}]: {error}") from None
+            start = k + 1
+        return {name: np.concatenate([part[name] for part in parts]) for name in parts[0]}
 
     def _trial(self, time: float, depth: float) -> tuple[float, float, float]:
         """Advance the model (only) from the current state to (time, depth); returns

@@ -22,6 +22,7 @@ import contextlib
 import gc
 import math
 import operator
+import os
 import sys
 import threading
 import time
@@ -64,6 +65,12 @@ from viscoadh_ros.ros import conversions, diagnostics, markers, parameters
 
 #: An idle contact (out of touch, relaxed) republishes its unchanging state at this period.
 IDLE_PUBLISH_PERIOD_NS = 1_000_000_000
+#: How long a stop (SIGINT, SIGTERM, `destroy_node`) waits for a step the live thread is in,
+#: and then for the process to exit (a service call such as a long ``simulate_history`` on an
+#: executor thread, which the interpreter's exit would wait for), s; past it the step or call
+#: is abandoned (see `main`). Steps are bounded (numerics ranges, `presets.MAX_SUBSTEPS`), but
+#: a legit large scene's step may take seconds, and a history any time.
+STOP_WAIT_S = 2.0
 #: Period of /diagnostics.
 DIAGNOSTICS_PERIOD_S = 1.0
 #: Minimum interval between two warnings of the same kind of rejection (throttled log), s.
@@ -891,15 +898,22 @@ class _LiveLoop:
     def start(self) -> None:
         self._thread.start()
 
-    def stop(self) -> None:
-        """Stop the thread and wait for it (idempotent)."""
+    def stop(self, timeout: float | None = None) -> bool:
+        """Stop the thread and wait for it, at most ``timeout`` s (None: until it stops);
+        False when it is still running (inside a step: the kernels release the GIL, so the
+        caller goes on; the thread ends at its next use of a destroyed entity, and is a daemon,
+        so it does not hold the process). Idempotent."""
         self._stopping = True
         if self._thread.is_alive():
-            self._wake.trigger()
-            self._thread.join()
+            if not self._wake_destroyed:
+                self._wake.trigger()
+            self._thread.join(timeout)
+            if self._thread.is_alive():
+                return False  # its wait set may still hold the guard condition: kept
         if not self._wake_destroyed:
             self._wake_destroyed = True
             self._wake.destroy()
+        return True
 
     def _clock_subscription(self) -> Any:
         """The node's ``/clock`` subscription, if ``use_sim_time`` made one, moved to this thread
@@ -1144,8 +1158,12 @@ class ViscoadhNode(Node):
         return SetParametersResult(successful=True)
 
     def destroy_node(self) -> None:
-        # Stop the live thread first: it uses the subscriptions, timers and publishers.
-        self._live.stop()
+        # Stop the live thread first: it uses the subscriptions, timers and publishers. A step
+        # still running after STOP_WAIT_S is abandoned (its answer is never published).
+        if not self._live.stop(STOP_WAIT_S):
+            self.get_logger().warning(
+                f"the live thread was still in a step {STOP_WAIT_S:g} s after the stop: not waiting for it"
+            )
         if self._recorder is not None:
             self._recorder.close()
             self._recorder = None
@@ -1223,6 +1241,7 @@ def main(args: list[str] | None = None) -> int:
         print(f"viscoadh node: error: ROS arguments rejected: {detail}", file=sys.stderr, flush=True)
         return 2
     node = None
+    code = 0
     try:
         node = ViscoadhNode(freeze=True)
         executor = MultiThreadedExecutor()
@@ -1237,10 +1256,10 @@ def main(args: list[str] | None = None) -> int:
                 break
         if node.live_error is not None:
             print(f"viscoadh node: error: live path failed: {node.live_error!r}", file=sys.stderr, flush=True)
-            return 1
+            code = 1
     except ConfigError as error:
         print(f"viscoadh node: error: {error}", file=sys.stderr, flush=True)
-        return 2
+        code = 2
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:
@@ -1249,4 +1268,32 @@ def main(args: list[str] | None = None) -> int:
             node.destroy_node()
             logger.info("finished")
         rclpy.try_shutdown()
-    return 0
+        _exit_after(STOP_WAIT_S, code)
+    return code
+
+
+def _exit_after(seconds: float, code: int) -> None:
+    """End the process with ``code`` if it has not exited ``seconds`` from now. The
+    interpreter's exit waits for the executor's threads, and a service call (a long
+    ``simulate_history``) may run for minutes: SIGTERM must still stop the node (0.10.0's
+    outside tester needed kill -9). A daemon timer: a process that exits in time never sees
+    it. Only for `main`, whose process ends when it returns."""
+
+    def abandon() -> None:
+        busy = sorted(
+            t.name
+            for t in threading.enumerate()
+            if t not in (threading.current_thread(), threading.main_thread()) and not t.daemon
+        )
+        print(
+            f"viscoadh node: still busy {seconds:g} s after the stop ({', '.join(busy) or 'exit'}): "
+            "exiting without waiting for it",
+            file=sys.stderr,
+            flush=True,
+        )
+        sys.stdout.flush()
+        os._exit(code)
+
+    timer = threading.Timer(seconds, abandon)
+    timer.daemon = True
+    timer.start()

@@ -41,6 +41,7 @@ from viscoadh_ros.core.config import (
     read_yaml,
 )
 from viscoadh_ros.core.errors import ConfigError
+from viscoadh_ros.core.presets import DOMAIN_RADIUS_RANGE, ELEMENTS_MAX, MAX_SUBSTEPS
 
 #: Parameters every rclpy node declares itself; they are not part of the scene.
 _RCLPY_PARAMETERS = frozenset({"use_sim_time", "start_type_description_service"})
@@ -120,17 +121,21 @@ _CONTACT_SPECS: dict[str, _Spec] = {
         "Model path: auto (cheapest exact path for the scene) | closed_form | time_stepped."
     ),
     "numerics.elements": _Spec(
-        "Number of MDR elements of the time-stepped model (0 = from the preset, else >= 4).",
+        f"Number of MDR elements of the time-stepped model (0 = from the preset, else 4..{ELEMENTS_MAX}).",
         low=0,
-        high=1_000_000,
+        high=ELEMENTS_MAX,
     ),
     "numerics.domain_radius": _Spec(
-        "Initial length of the element row, m (0 = from the scene; grows with the contact).",
+        "Initial length of the element row, m (0 = from the scene, else "
+        f"{DOMAIN_RADIUS_RANGE[0]:g}..{DOMAIN_RADIUS_RANGE[1]:g}; grows with the contact).",
         low=0.0,
-        high=_INF,
+        high=DOMAIN_RADIUS_RANGE[1],
     ),
     "numerics.max_substep": _Spec(
-        "Longest internal time substep, s (0 = from the preset).", low=0.0, high=_INF
+        f"Longest internal time substep, s (0 = none); a step longer than {MAX_SUBSTEPS} of them "
+        "is refused.",
+        low=0.0,
+        high=_INF,
     ),
     "numerics.force_tolerance": _Spec(
         "Relative force tolerance of force control (0 = from the preset, < 1).",
