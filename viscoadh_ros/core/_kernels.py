@@ -4174,6 +4174,41 @@ def _advance_packed(state, const, journal, a, d0, d1, dt, max_substep, max_edge_
 PHASE_NO_CONTACT, PHASE_INDENTING, PHASE_STICKING, PHASE_DETACHING = 0, 1, 2, 3
 
 
+@numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
+def _derived_outputs(radius, r0, rest, d1, dt, outside, inside, g_edge, c_crit, e_relaxed, v_c1, v_c2):
+    """A step's derived outputs from the kernel's: ``(phase code, edge speed m/s, effective
+    work of adhesion J/m^2, scale separation)``, as `simulator._phase` and
+    `ContactSimulator.step` computed them in Python (the same IEEE operations in the same
+    order: the same bits). ``rest``: an edge that moved less than this (m) is at rest;
+    ``outside``/``inside``/``g_edge``: the edge gaps and g at the edge (read only in contact).
+    `_step_packed` per call and `_batch_columns` per row."""
+    if radius <= 0.0:
+        phase = PHASE_NO_CONTACT
+    elif radius > r0 + rest:
+        phase = PHASE_INDENTING
+    elif radius < r0 - rest:
+        phase = PHASE_DETACHING
+    else:
+        tol = 1e-9 * (abs(d1) + c_crit * math.sqrt(radius) + g_edge)
+        if outside >= -tol:
+            phase = PHASE_INDENTING
+        elif inside <= tol:
+            phase = PHASE_DETACHING
+        else:
+            phase = PHASE_STICKING
+    edge_speed = (radius - r0) / dt if dt > 0.0 else 0.0
+    u = d1 - g_edge
+    if radius > 0.0 and u < 0.0:
+        effective = e_relaxed * u * u / (2.0 * math.pi * radius)
+    else:
+        effective = 0.0
+    if edge_speed == 0.0:
+        separated = True
+    else:
+        separated = abs(edge_speed) >= (v_c1 if edge_speed > 0.0 else v_c2)
+    return phase, edge_speed, effective, separated
+
+
 # With the runtime, like `_advance_packed` (the views `_unpack` makes carry no reference
 # count). Its return value is a tuple of scalars: boxing it costs less than reading the same
 # values back from ``out`` in Python.
@@ -4215,32 +4250,10 @@ def _step_packed(
     inside = out[OUT_GAP_INSIDE]
     g_edge = out[OUT_G_EDGE] if radius > 0.0 else 0.0
     # `simulator._phase`: an edge that moved less than twice its location tolerance is at rest.
-    if radius <= 0.0:
-        phase = PHASE_NO_CONTACT
-    else:
-        rest = 2.0 * EDGE_TOLERANCE * dx
-        if radius > r0 + rest:
-            phase = PHASE_INDENTING
-        elif radius < r0 - rest:
-            phase = PHASE_DETACHING
-        else:
-            tol = 1e-9 * (abs(d1) + args[16] * math.sqrt(radius) + g_edge)
-            if outside >= -tol:
-                phase = PHASE_INDENTING
-            elif inside <= tol:
-                phase = PHASE_DETACHING
-            else:
-                phase = PHASE_STICKING
-    edge_speed = (radius - r0) / dt if dt > 0.0 else 0.0
-    u = d1 - g_edge
-    if radius > 0.0 and u < 0.0:
-        effective = e_relaxed * u * u / (2.0 * math.pi * radius)
-    else:
-        effective = 0.0
-    if edge_speed == 0.0:
-        separated = True
-    else:
-        separated = abs(edge_speed) >= (v_c1 if edge_speed > 0.0 else v_c2)
+    phase, edge_speed, effective, separated = _derived_outputs(
+        radius, r0, 2.0 * EDGE_TOLERANCE * dx, d1, dt, outside, inside, g_edge, args[16], e_relaxed, v_c1,
+        v_c2,
+    )
     return (
         status,
         radius,
@@ -4268,9 +4281,10 @@ def _batch_columns(
     and the energy input before it ``energy0``.
 
     Each element the same IEEE operations in the same order as the numpy expressions it
-    replaces (and as `_step_packed` per call): the same bits. The energy input is the running
-    sum in row order, as ``np.cumsum`` takes it. Those ~25 array operations on a 400-row call
-    cost about as much as the kernel's rows at N = 64 (0.11.0 `rest`).
+    replaced (`_derived_outputs`, which `_step_packed` calls per call): the same bits. The
+    energy input is the running sum in row order, as ``np.cumsum`` takes it. Those ~25 array
+    operations on a 400-row call cost about as much as the kernel's rows at N = 64 (0.11.0
+    `rest`).
 
     A repeated sample (`ContactSimulator._repeats`: no time, the depth of the row before, which
     is not a contact at rest) takes the row before's phase, edge speed, effective work and
@@ -4303,30 +4317,14 @@ def _batch_columns(
             energy[i] = total
             before = radius_i
             continue
-        g = gaps[i, 2]
-        if radius_i <= 0.0:
-            code = PHASE_NO_CONTACT
-        elif radius_i > before + rest[i]:
-            code = PHASE_INDENTING
-        elif radius_i < before - rest[i]:
-            code = PHASE_DETACHING
-        else:
-            tol = 1e-9 * (abs(d[i]) + c_crit * math.sqrt(radius_i) + g)
-            if gaps[i, 0] >= -tol:
-                code = PHASE_INDENTING
-            elif gaps[i, 1] <= tol:
-                code = PHASE_DETACHING
-            else:
-                code = PHASE_STICKING
+        code, speed, effect, separated = _derived_outputs(
+            radius_i, before, rest[i], d[i], steps[i], gaps[i, 0], gaps[i, 1], gaps[i, 2], c_crit, e_relaxed,
+            v_c1, v_c2,
+        )
         phase[i] = code
-        speed = (radius_i - before) / steps[i] if steps[i] > 0.0 else 0.0
         edge_speed[i] = speed
-        u = d[i] - g
-        if radius_i > 0.0 and u < 0.0:
-            effective[i] = e_relaxed * u * u / (2.0 * math.pi * radius_i)
-        else:
-            effective[i] = 0.0
-        ok[i] = speed == 0.0 or abs(speed) >= (v_c1 if speed > 0.0 else v_c2)
+        effective[i] = effect
+        ok[i] = separated
         total = total + work[i]
         energy[i] = total
         before = radius_i
@@ -4334,8 +4332,8 @@ def _batch_columns(
         repeatable = not (radius_i == 0.0 and force[i] == 0.0 and total == 0.0 and dissipated[i] == 0.0)
         code_before = code
         speed_before = speed
-        effective_before = effective[i]
-        ok_before = ok[i]
+        effective_before = effect
+        ok_before = separated
     return phase, edge_speed, effective, energy, ok
 
 
