@@ -410,6 +410,13 @@ def _events_topic(inputs: str) -> str:
     return inputs.rsplit("/", 1)[0] + "/events"
 
 
+def _contact_of(inputs: str) -> str:
+    """The contact a node log's input topic belongs to, for messages: ``finger`` of
+    ``/finger/indentation`` (the topic itself when it has no namespace)."""
+    parts = inputs.strip("/").split("/")
+    return parts[-2] if len(parts) > 1 else inputs
+
+
 @dataclass(frozen=True)
 class _StateCounts:
     """The counters of a contact's logged ContactStates (``C/state``): how many commands the
@@ -469,8 +476,8 @@ def _refuse_broken_sequence(bag: Bag, inputs: str, order: NDArray[np.int64], cou
         return
     logged = np.searchsorted(np.sort(order), counts.order)
     ahead = counts.received + counts.rejected - logged
-    files = np.searchsorted(np.asarray(bag.file_starts), counts.order, side="right") - 1
-    contact = inputs.strip("/").split("/")[-2] if inputs.strip("/").count("/") else inputs
+    files = bag.file_of(counts.order)
+    contact = _contact_of(inputs)
     last: tuple[int, int] | None = None
     for file in np.unique(files).tolist():
         here = int(ahead[files == file].min())
@@ -506,7 +513,7 @@ def _refuse_mid_history(
     the earlier history no longer matters: such a record replays exactly."""
     if earlier <= 0 or (restarts and restarts[0].order < int(np.min(order))):
         return
-    contact = inputs.strip("/").split("/")[-2] if inputs.strip("/").count("/") else inputs
+    contact = _contact_of(inputs)
     raise InputError(
         f"contact {contact!r}: {str(bag.path)!r} starts in the middle of the contact's history: the "
         f"node had received {earlier} commands on {inputs!r} before the first one recorded here (its "

@@ -564,9 +564,9 @@ class Bag:
                 ) from None
             yield RecordedMessage(name, self._topics[name].type_name, log_time, msg, order)
 
-    def file_of(self, order: int) -> int:
-        """The index in `files` of the file holding the message at position ``order``."""
-        return int(np.searchsorted(np.asarray(self.file_starts), order, side="right")) - 1
+    def file_of(self, order: NDArray[np.int64]) -> NDArray[np.intp]:
+        """The index in `files` of the file holding each message at positions ``order``."""
+        return np.searchsorted(np.asarray(self.file_starts), order, side="right") - 1
 
     def scene(self, file: int | None = None) -> dict[str, Any] | None:
         """The scene stored by our recorder (``SceneConfig.to_dict()`` form), if any: the one
