@@ -49,15 +49,12 @@ def old_cols(sim, t, d, radius, work, gaps, rest, steps):
     return phase, edge_speed, effective, energy_input, ok
 
 
-def check(label, sim, t, d):
-    t = np.ascontiguousarray(t, dtype=np.float64)
-    d = np.ascontiguousarray(d, dtype=np.float64)
-    steps = np.diff(t, prepend=sim._time)
-    radius, force, work, dissipated, gaps, rest = sim._model.advance_rows(sim, t, d)
-    old = old_cols(sim, t, d, radius, work, gaps, rest, steps)
+def new_cols(sim, d, steps, radius, gaps, rest, work, force, dissipated):
+    """`_kernels._batch_columns` as `step_depths` calls it from ``sim``'s state, with no
+    repeated sample before the first row (the histories have none)."""
     p = sim.physics
     v1, v2 = p.critical_speeds
-    new = _kernels._batch_columns(
+    return _kernels._batch_columns(
         d,
         steps,
         radius,
@@ -72,8 +69,17 @@ def check(label, sim, t, d):
         v2,
         force,
         dissipated,
-        np.zeros(6),  # no repeated sample before the first row (the histories have none)
+        np.zeros(6),
     )
+
+
+def check(label, sim, t, d):
+    t = np.ascontiguousarray(t, dtype=np.float64)
+    d = np.ascontiguousarray(d, dtype=np.float64)
+    steps = np.diff(t, prepend=sim._time)
+    radius, force, work, dissipated, gaps, rest = sim._model.advance_rows(sim, t, d)
+    old = old_cols(sim, t, d, radius, work, gaps, rest, steps)
+    new = new_cols(sim, d, steps, radius, gaps, rest, work, force, dissipated)
     # Since the repeated-sample fix (0.11.0), a row that repeats the row before (no time, the
     # same depth, not at rest) takes that row's columns, where the old expressions recomputed
     # them: compared on the other rows only.
@@ -96,30 +102,12 @@ def timed(nk):
     steps = np.diff(t, prepend=sim._time)
     radius, force, work, dissipated, gaps, rest = sim._model.advance_rows(sim, t, d)
     sim.restore(start)
-    p = sim.physics
-    v1, v2 = p.critical_speeds
 
     def old():
         old_cols(sim, t, d, radius, work, gaps, rest, steps)
 
     def new():
-        _kernels._batch_columns(
-            d,
-            steps,
-            radius,
-            gaps,
-            rest,
-            work,
-            sim._output.contact_radius,
-            sim._energy_input,
-            p.c_crit,
-            p.e_relaxed,
-            v1,
-            v2,
-            force,
-            dissipated,
-            np.zeros(6),
-        )
+        new_cols(sim, d, steps, radius, gaps, rest, work, force, dissipated)
 
     def batch():
         sim.restore(start)
