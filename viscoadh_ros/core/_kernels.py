@@ -126,7 +126,7 @@ TOUCH_BLOCK = 32
 
 #: The centre-crossing blend (`_edge_piece`) applies with the share ``max(0, 1 - CENTRE_CUT
 #: v tau / dx)`` (`_relaxed_share`): in full where the cell behind the edge is relaxed, none
-#: once the edge crosses a cell in 1 / CENTRE_CUT relaxation times or less.
+#: once the edge crosses a cell in CENTRE_CUT relaxation times or less (v tau >= dx / CENTRE_CUT).
 CENTRE_CUT = 4.0
 
 
@@ -863,8 +863,8 @@ def _relaxed_share(b_prev, b_relaxed):
     towards ``kap`` whatever the depth does, so an element attached one cell's passage ago
     holds ``r = B / kap = 1 - exp(-dx / (v tau))`` and ``v tau / dx = -1 / ln(1 - r)``. A
     relaxed cell behind the edge (a slow press, v tau << dx: r = 1 to rounding) takes the full
-    blend, which removes the jump; a cell the edge crossed within a quarter of a relaxation
-    time (v tau >= dx / 4, r <= 1 - e^-4) none: there the memory behind the edge is not
+    blend, which removes the jump; a cell the edge crossed within four relaxation times
+    (v tau >= dx / 4, r <= 1 - e^-4) none: there the memory behind the edge is not
     relaxed, element L-1 read on to the edge overshoots, and the old reading is closer to 8192
     elements. Measured against 8192 elements (benchmarks/centre_accuracy.py, round
     0.11.0-centre.md, sessions 11 and 12): on the rows the blend moves of the finger's
