@@ -1,7 +1,7 @@
 """Depth-control force of the scenes whose tests moved with the centre-crossing blend, against
 the same scene at 8192 elements (round 0.11.0-centre).
 
-    PYTHONPATH=<checkout> python benchmarks/centre_accuracy.py <checkout> [out.npz]
+    PYTHONPATH=<checkout> python benchmarks/centre_accuracy.py <checkout> [out.npz [base.npz]]
 
 Runs the tests' histories of <checkout> under depth control at the contact's own numerics and
 at ``elements: 8192`` (same preset and model otherwise) and prints, per scene, the largest and
@@ -11,6 +11,9 @@ moves a fit). The four force-search cases run the depths 0.2.0 reached under for
 (tests/force_control_golden.npz), the node-log scene the finger's press-pull of
 tests/test_fit_node_log.py (0.5 s, 10 ms rows), and the same at w = 0.2 J/m^2 the stretch
 tests/test_replay_parameters.py fits G0 on (equal to the node's logged force to 1e-15).
+With ``base.npz`` (this script's output for another kernel, e.g. main's) it also prints, per
+scene, the rows this kernel moved (by more than 1e-12 P, same contact state in both): how many,
+their mean and largest error before and after, how many got closer, the mean signed error.
 """
 
 from __future__ import annotations
@@ -101,3 +104,22 @@ for name, (contact, t, d) in scenes.items():
     out[f"{name}/a_ref"], out[f"{name}/a_own"] = a_ref, a_own
 if len(sys.argv) > 2:
     np.savez(sys.argv[2], **out)
+if len(sys.argv) > 3:
+    base = np.load(sys.argv[3])
+    print(f"\nrows moved against {sys.argv[3]}: |F - F_8192| / P before -> after")
+    for name in scenes:
+        ref, p = out[f"{name}/ref"], out[f"{name}/p"]
+        old, new = base[f"{name}/own"], out[f"{name}/own"]
+        state = out[f"{name}/a_ref"] > 0.0
+        same = ((base[f"{name}/a_own"] > 0.0) == state) & ((out[f"{name}/a_own"] > 0.0) == state)
+        moved = same & (np.abs(new - old) > 1e-12 * p)
+        if not moved.any():
+            print(f"{name:26s} no row moved")
+            continue
+        e_old, e_new = (old - ref)[moved] / p, (new - ref)[moved] / p
+        a_old, a_new = np.abs(e_old), np.abs(e_new)
+        print(
+            f"{name:26s} {int(moved.sum()):5d} rows: mean {a_old.mean():.3e} -> {a_new.mean():.3e},"
+            f" largest {a_old.max():.3e} -> {a_new.max():.3e}, closer {int((a_new < a_old).sum())},"
+            f" signed {e_old.mean():+.2e} -> {e_new.mean():+.2e}"
+        )
