@@ -28,7 +28,7 @@ Two orders of events:
   is skipped; a ``RESET`` or ``PARAMETERS`` event restarts the contact at its place in the
   log (fresh state, at rest until the next accepted command; PARAMETERS with the contact
   configuration it carries), and the next accepted command starts a new time base, as in the
-  node.
+  node; a ``PARAMETERS_REFUSED`` event (a runtime change the node refused) changes nothing.
 - Any other recording runs by stamp; at equal stamps in recording order.
 
 A record must hold the contact's history from its start: when the contact's logged
@@ -71,7 +71,7 @@ INPUT_TYPES = (COMMAND, FLOAT64, POINT, POSE)
 FORCE_TYPES = (WRENCH, FLOAT64)
 
 DEPTH, FORCE = 0, 1  # input modes, equal to IndentationCommand.DEPTH / FORCE
-COMMAND_REJECTED, RESET, PARAMETERS = 1, 2, 3  # ContactEvent.kind
+COMMAND_REJECTED, RESET, PARAMETERS, PARAMETERS_REFUSED = 1, 2, 3, 4  # ContactEvent.kind
 
 
 @dataclass(frozen=True)
@@ -575,7 +575,7 @@ def _node_events(bag: Bag, inputs: str) -> tuple[str | None, tuple[Restart, ...]
             restarts.append(
                 Restart(int(event.kind), stamp or message.log_time_ns, message.order, event.contact_yaml)
             )
-        else:
+        elif event.kind != PARAMETERS_REFUSED:  # a refused change changed nothing
             raise InputError(f"{topic}: event of unknown kind {event.kind} at {message.log_time_ns} ns")
     return topic, tuple(sorted(restarts, key=lambda r: r.order)), rejections
 
