@@ -781,14 +781,21 @@ class Material:
     replaced: dict[str, Any] = field(default_factory=dict)
     given: bool = False  # True: the change applied to the user's scene; False: the node's contact
 
+    def _at(self, experiment: Experiment) -> float:
+        """Record time of the change, s (0 for the record's start; < 0 before its first input)."""
+        return 0.0 if self.ns is None else float(experiment.time(np.array([self.ns]))[0])
+
     def describe(self, experiment: Experiment, start: str) -> str:
         """``t = 4.07 s on: <what>``; ``start``: what the record starts with."""
-        at = 0.0 if self.ns is None else float(experiment.time(np.array([self.ns]))[0])
+        at = self._at(experiment)
         if self.ns is None:
             return f"t = {at:.6g} s on: {start}"
         change = ", ".join(f"{k} {_value_text(a)} -> {_value_text(b)}" for k, (a, b) in self.changed.items())
         change = f"the logged parameter change {change or '(nothing of this contact)'}"
-        text = f"t = {at:.6g} s on: " + (
+        # A change made before the record's first input has a negative record time (an outside
+        # tester read "t = -0.073 s" as a fault): say what it means.
+        before = " (before the first input)" if at < 0.0 else ""
+        text = f"t = {at:.6g} s{before} on: " + (
             f"{change} applied to the --scene contact" if self.given else f"the node's contact after {change}"
         )
         if self.replaced:
@@ -801,9 +808,8 @@ class Material:
 
     def as_dict(self, experiment: Experiment) -> dict[str, Any]:
         """JSON-ready: ``from_s``, ``changed`` ``{key: [before, after]}``, ``replaced``."""
-        at = 0.0 if self.ns is None else float(experiment.time(np.array([self.ns]))[0])
         return {
-            "from_s": at,
+            "from_s": self._at(experiment),
             "changed": {k: [a, b] for k, (a, b) in self.changed.items()},
             "replaced": dict(self.replaced),
         }
