@@ -161,3 +161,35 @@ def test_node_in_process_runs_at_the_nodes_gil_switch_interval() -> None:
     with node_in_process(SceneConfig.from_yaml(default_scene_path())):
         assert sys.getswitchinterval() == pytest.approx(GIL_SWITCH_INTERVAL_S)
     assert sys.getswitchinterval() == before
+
+
+@pytest.mark.parametrize(
+    "inward, outward, loop, lost, expected",
+    [
+        # The default (viscoelastic) scene's numbers: the paper's effect and energy still stored.
+        (2.381e-3, 5e-2, 3.414e-6, 2.667e-6, ["weak on the way in", "strong on the way out", "still stored"]),
+        # An elastic scene (the outside tester's --scene config/examples/elastic.yaml): the same
+        # work both ways, and the loop's area is what was dissipated.
+        (44e-3, 44e-3, 1.85e-9, 1.855e-9, ["about the same both ways", "nothing is left stored"]),
+    ],
+)
+def test_the_report_commentary_follows_the_numbers(inward, outward, loop, lost, expected):
+    from viscoadh_ros.demo import DemoSummary, format_summary
+
+    summary = DemoSummary(
+        predicted_pull_off=-1e-3,
+        reached_pull_off=-1e-3,
+        approach_work_of_adhesion=inward,
+        release_work_of_adhesion=outward,
+        reference=sphere_reference(DEFAULT_CONTACT),
+        loop_energy=loop,
+        dissipated_energy=lost,
+        simulated_time=1.0,
+        wall_time=1.0,
+        commands=10,
+    )
+    report = format_summary(summary, {})
+    for text in expected:
+        assert text in report, report
+    if "weak on the way in" not in expected:
+        assert "weak on the way in" not in report and "still stored" not in report, report

@@ -364,6 +364,21 @@ def format_summary(summary: DemoSummary, files: dict[str, Path]) -> str:
     """The demo's printed report: a few lines, SI units with readable prefixes."""
     ref = summary.reference
     limit = -1.5 * math.pi * ref.radius * ref.work_detachment
+    # The commentary follows the numbers: an elastic scene (`--scene`) adheres the same both
+    # ways and stores nothing after the cycle (an outside tester read "weak on the way in" beside
+    # two equal values).
+    inward, outward = summary.approach_work_of_adhesion, summary.release_work_of_adhesion
+    if outward > 1.05 * inward:
+        way_in, way_out = "weak on the way in", "strong on the way out"
+    else:
+        way_in = way_out = "about the same both ways (no memory to strengthen the release)"
+    loop, lost = summary.loop_energy, summary.dissipated_energy
+    if abs(loop - lost) <= 1e-2 * max(abs(loop), abs(lost)):
+        stored = "the same within 1 %: nothing is left stored"
+    elif loop > lost:
+        stored = "the rest is still stored in the creeping surface"
+    else:
+        stored = "more than the loop's area: the cycle did not return to where it started"
     lines = [
         (
             f"cycle: {summary.commands} commands over {summary.simulated_time:.3g} s of "
@@ -375,16 +390,15 @@ def format_summary(summary: DemoSummary, files: dict[str, Path]) -> str:
         ),
         (
             f"work of adhesion in   {_si(summary.approach_work_of_adhesion, 'J/m^2')} "
-            f"(paper's w_eff1 = {_si(ref.work_indentation, 'J/m^2')}): weak on the way in"
+            f"(paper's w_eff1 = {_si(ref.work_indentation, 'J/m^2')}): {way_in}"
         ),
         (
             f"work of adhesion out  {_si(summary.release_work_of_adhesion, 'J/m^2')} at pull-off "
-            f"(paper's w_eff2 = {_si(ref.work_detachment, 'J/m^2')}): strong on the way out"
+            f"(paper's w_eff2 = {_si(ref.work_detachment, 'J/m^2')}): {way_out}"
         ),
         (
             f"energy lost in cycle  {_si(summary.loop_energy, 'J')} (force-depth loop area; "
-            f"dissipated so far {_si(summary.dissipated_energy, 'J')}, the rest is still "
-            "stored in the creeping surface)"
+            f"dissipated so far {_si(summary.dissipated_energy, 'J')}, {stored})"
         ),
     ]
     lines += [f"{name + ':':<22}{path}" for name, path in files.items()]

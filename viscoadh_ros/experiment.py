@@ -28,7 +28,7 @@ Two orders of events:
   is skipped; a ``RESET`` or ``PARAMETERS`` event restarts the contact at its place in the
   log (fresh state, at rest until the next accepted command; PARAMETERS with the contact
   configuration it carries), and the next accepted command starts a new time base, as in the
-  node.
+  node; a ``PARAMETERS_REFUSED`` event (a runtime change the node refused) changes nothing.
 - Any other recording runs by stamp; at equal stamps in recording order.
 
 A record must hold the contact's history from its start: when the contact's logged
@@ -71,7 +71,7 @@ INPUT_TYPES = (COMMAND, FLOAT64, POINT, POSE)
 FORCE_TYPES = (WRENCH, FLOAT64)
 
 DEPTH, FORCE = 0, 1  # input modes, equal to IndentationCommand.DEPTH / FORCE
-COMMAND_REJECTED, RESET, PARAMETERS = 1, 2, 3  # ContactEvent.kind
+COMMAND_REJECTED, RESET, PARAMETERS, PARAMETERS_REFUSED = 1, 2, 3, 4  # ContactEvent.kind
 
 
 @dataclass(frozen=True)
@@ -575,7 +575,7 @@ def _node_events(bag: Bag, inputs: str) -> tuple[str | None, tuple[Restart, ...]
             restarts.append(
                 Restart(int(event.kind), stamp or message.log_time_ns, message.order, event.contact_yaml)
             )
-        else:
+        elif event.kind != PARAMETERS_REFUSED:  # a refused change changed nothing
             raise InputError(f"{topic}: event of unknown kind {event.kind} at {message.log_time_ns} ns")
     return topic, tuple(sorted(restarts, key=lambda r: r.order)), rejections
 
@@ -781,14 +781,21 @@ class Material:
     replaced: dict[str, Any] = field(default_factory=dict)
     given: bool = False  # True: the change applied to the user's scene; False: the node's contact
 
+    def _at(self, experiment: Experiment) -> float:
+        """Record time of the change, s (0 for the record's start; < 0 before its first input)."""
+        return 0.0 if self.ns is None else float(experiment.time(np.array([self.ns]))[0])
+
     def describe(self, experiment: Experiment, start: str) -> str:
         """``t = 4.07 s on: <what>``; ``start``: what the record starts with."""
-        at = 0.0 if self.ns is None else float(experiment.time(np.array([self.ns]))[0])
+        at = self._at(experiment)
         if self.ns is None:
             return f"t = {at:.6g} s on: {start}"
         change = ", ".join(f"{k} {_value_text(a)} -> {_value_text(b)}" for k, (a, b) in self.changed.items())
         change = f"the logged parameter change {change or '(nothing of this contact)'}"
-        text = f"t = {at:.6g} s on: " + (
+        # A change made before the record's first input has a negative record time (an outside
+        # tester read "t = -0.073 s" as a fault): say what it means.
+        before = " (before the first input)" if at < 0.0 else ""
+        text = f"t = {at:.6g} s{before} on: " + (
             f"{change} applied to the --scene contact" if self.given else f"the node's contact after {change}"
         )
         if self.replaced:
@@ -801,9 +808,8 @@ class Material:
 
     def as_dict(self, experiment: Experiment) -> dict[str, Any]:
         """JSON-ready: ``from_s``, ``changed`` ``{key: [before, after]}``, ``replaced``."""
-        at = 0.0 if self.ns is None else float(experiment.time(np.array([self.ns]))[0])
         return {
-            "from_s": at,
+            "from_s": self._at(experiment),
             "changed": {k: [a, b] for k, (a, b) in self.changed.items()},
             "replaced": dict(self.replaced),
         }

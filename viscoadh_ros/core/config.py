@@ -173,10 +173,12 @@ class NodeConfig:
     log_enabled [log.enabled], log_path [log.path]: MCAP logging and its file/folder.
     log_chunk_size [log.chunk_size]: MCAP chunk size, bytes (> 0).
     log_max_bytes [log.max_bytes]: rotate after this many bytes (0 = never).
-    log_max_duration [log.max_duration]: rotate after this many seconds (0 = never).
+    log_max_duration [log.max_duration]: rotate after this many seconds (0 = never; at most
+      :data:`DURATION_MAX_S`).
     log_queue_size [log.queue_size]: bound of the writer queue, messages (> 0).
     command_max_future_s [command.max_future_s]: how far ahead of the node clock a command's
-      ``header.stamp`` may be, s (>= 0); a command stamped further ahead is rejected.
+      ``header.stamp`` may be, s (0..:data:`DURATION_MAX_S`); a command stamped further ahead
+      is rejected.
     command_queue_depth [command.queue_depth]: commands each command subscription
       (``C/indentation``, ``hand/indentation``) holds for the live thread, keep last
       (1..:data:`COMMAND_QUEUE_DEPTH_MAX`): a node that falls behind by more loses the oldest.
@@ -234,6 +236,11 @@ _SHAPE_KEYS = {
     "power_law": ("coefficient", "exponent"),
     "table": ("table_radius", "table_height"),
 }
+#: Longest duration a node setting in seconds may give (``log.max_duration``,
+#: ``command.max_future_s``), s: about 31.7 years; the node holds them in integer nanoseconds
+#: (1e300 s overflowed the conversion and stopped the node).
+DURATION_MAX_S = 1e9
+
 #: Physical range of every indenter, material and adhesion number, relative key -> (low, high,
 #: unit), both ends included (lists: every element). Outside it the model would compute with
 #: numbers no body has (G0 = 1e-300 Pa gives a contact radius of 1e98 m) or overflow (1e308 Pa);
@@ -507,9 +514,13 @@ def _build_node(given: dict[str, Any]) -> NodeConfig:
         ),
         ("log.chunk_size", node.log_chunk_size > 0, "> 0"),
         ("log.max_bytes", node.log_max_bytes >= 0, ">= 0"),
-        ("log.max_duration", node.log_max_duration >= 0.0, ">= 0"),
+        ("log.max_duration", 0.0 <= node.log_max_duration <= DURATION_MAX_S, f"in [0, {DURATION_MAX_S:g}] s"),
         ("log.queue_size", node.log_queue_size > 0, "> 0"),
-        ("command.max_future_s", node.command_max_future_s >= 0.0, ">= 0"),
+        (
+            "command.max_future_s",
+            0.0 <= node.command_max_future_s <= DURATION_MAX_S,
+            f"in [0, {DURATION_MAX_S:g}] s",
+        ),
         (
             "command.queue_depth",
             1 <= node.command_queue_depth <= COMMAND_QUEUE_DEPTH_MAX,

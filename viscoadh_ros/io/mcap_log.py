@@ -50,6 +50,7 @@ from mcap.records import (
 from numpy.typing import NDArray
 
 from viscoadh_ros import __version__
+from viscoadh_ros.core.config import DURATION_MAX_S
 from viscoadh_ros.core.errors import ConfigError
 from viscoadh_ros.io.ros_schemas import schema_text, type_name_of
 
@@ -448,8 +449,8 @@ class McapRecorder:
                 raise ConfigError(f"log.{name} must be an integer > 0 (got {value!r})")
         if not isinstance(max_bytes, int) or max_bytes < 0:
             raise ConfigError(f"log.max_bytes must be an integer >= 0 (got {max_bytes!r})")
-        if not max_duration >= 0.0 or max_duration == float("inf"):
-            raise ConfigError(f"log.max_duration must be finite and >= 0 s (got {max_duration!r})")
+        if not 0.0 <= max_duration <= DURATION_MAX_S:
+            raise ConfigError(f"log.max_duration must be in [0, {DURATION_MAX_S:g}] s (got {max_duration!r})")
         path = (
             Path(path) if str(path) else Path(datetime.datetime.now().strftime("viscoadh_%Y_%m_%d-%H_%M_%S"))
         )

@@ -75,8 +75,9 @@ def contact_status(
     """The status of one contact; takes (and resets) the step-time and rejection windows.
 
     Level WARN when the current state lies outside the model's validity (flank slope at the
-    contact edge beyond the small-slope limit, or no scale separation of the energy criterion:
-    `ContactSimulator.model_validity`) or something was rejected since the last report, else OK.
+    contact edge beyond the small-slope limit, no scale separation of the energy criterion, or
+    a contact the grid does not resolve: `ContactSimulator.model_validity`) or something was
+    rejected since the last report, else OK.
     """
     steps, mean, maximum = counters.steps.take()
     problems = []
@@ -90,6 +91,7 @@ def contact_status(
         "in_contact": str(in_contact),
         "scale_separation_ok": str(validity.scale_separation_ok),
         "small_slope_ok": str(validity.small_slope_ok),
+        "resolution_ok": str(validity.resolution_ok),
         "edge_slope": f"{validity.edge_slope:.3g}",
         "steps_in_window": str(steps),
         "step_time_mean_us": f"{mean * 1e6:.1f}",

@@ -523,14 +523,18 @@ class _Contact:
             copy.restore(snapshot)
             if now_s > copy.time:
                 copy.advance(now_s)
+            in_contact = copy.in_contact
             prediction = predict_pull_off(copy, speed)
         except ValueError as error:
             return self._fail(response, f"predict_pull_off rejected: {error}")
         response.pull_off_force = float(prediction.pull_off_force)
         response.pull_off_depth = float(prediction.pull_off_depth)
         response.time_to_detach = float(prediction.time_to_detach)
-        response.success = True
-        response.message = f"retracting at {speed:g} m/s"
+        # A pull-off was found only if the contact was touching and let go within the run's
+        # range; otherwise the core's message says which (nothing to pull off, or the values up
+        # to where the run stopped).
+        response.success = bool(in_contact and prediction.detached)
+        response.message = prediction.message
         return response
 
     def on_reset(self, request: Trigger.Request, response: Trigger.Response) -> Trigger.Response:
@@ -551,11 +555,15 @@ class _Contact:
 
     # --- reconfiguration and diagnostics -----------------------------------------------------
 
-    def replace_config_locked(self, config: ContactConfig, scene: SceneConfig) -> None:
-        """Use ``config`` from now on, a contact that has received no command (caller holds the
-        lock and checked the contact is idle); a PARAMETERS event carries the new contact."""
+    def replace_config_locked(
+        self, config: ContactConfig, simulator: ContactSimulator, scene: SceneConfig
+    ) -> None:
+        """Use ``config`` and its fresh ``simulator`` (built before any contact changed, so a
+        scene that cannot be simulated changes nothing) from now on, a contact that has received
+        no command (caller holds the lock and checked the contact is idle); a PARAMETERS event
+        carries the new contact."""
         self.config = config
-        self.simulator = ContactSimulator(config)
+        self.simulator = simulator
         self._reset_locked()
         contact_scene = SceneConfig(contacts=(config,), node=scene.node)
         self.event_locked(
@@ -1120,28 +1128,36 @@ class ViscoadhNode(Node):
         for parameter in changed:
             owner = parameters.classify_change(parameter.name, ids)
             if owner is None:
-                return _refuse(f"{parameter.name} is not a scene parameter")
+                return self._refuse_change(parameters.not_a_scene_parameter(parameter.name), touched)
             if owner == "" and parameter.name not in parameters.RUNTIME_NODE_PARAMETERS:
-                return _refuse(f"{parameter.name} cannot change while the node runs")
+                return self._refuse_change(f"{parameter.name} cannot change while the node runs", touched)
             if owner:
                 touched.add(owner)
             flat[parameter.name] = parameter.value
         try:
             scene = SceneConfig.from_parameters(flat)
-        except ConfigError as error:
-            return _refuse(str(error))
+            # Every touched contact's simulator is built before any contact changes: a scene the
+            # schema accepts may still be one the model cannot run (numerics.model closed_form
+            # on a body with memory), and that must refuse the change, not stop the node.
+            simulators = {cid: ContactSimulator(scene.contact(cid)) for cid in sorted(touched)}
+        except (ConfigError, InputError) as error:
+            return self._refuse_change(str(error), touched)
         with self._parameter_lock, contextlib.ExitStack() as stack:
             for contact_id in sorted(touched):
                 stack.enter_context(self.contacts[contact_id].lock)
             for contact_id in sorted(touched):
                 if not self.contacts[contact_id].simulator.is_idle:
-                    return _refuse(
+                    return self._refuse_change(
                         f"contact '{contact_id}' is in contact or still relaxing; change its "
                         "parameters when it is out of touch and relaxed (or after "
-                        f"{contact_id}/reset)"
+                        f"{contact_id}/reset)",
+                        touched,
+                        locked=True,
                     )
             for contact_id in touched:
-                self.contacts[contact_id].replace_config_locked(scene.contact(contact_id), scene)
+                self.contacts[contact_id].replace_config_locked(
+                    scene.contact(contact_id), simulators[contact_id], scene
+                )
             if self._recorder is not None:
                 # After the PARAMETERS events and before the touched contacts' next commands (their
                 # locks are held): a file the recorder starts from here on names the new scene.
@@ -1156,6 +1172,20 @@ class ViscoadhNode(Node):
         self.max_future_ns = round(scene.node.command_max_future_s * _NS_PER_S)
         self.scene = scene
         return SetParametersResult(successful=True)
+
+    def _refuse_change(self, reason: str, touched: set[str], *, locked: bool = False) -> SetParametersResult:
+        """Refuse a runtime parameter change: nothing changes. The refusal is answered to the
+        caller, warned on the node's log and, for each contact the change named, published and
+        logged as a PARAMETERS_REFUSED event (``locked``: the caller holds those contacts' locks)."""
+        self.get_logger().warning(f"parameter change refused: {reason}")
+        now_ns = self.now_ns()
+        for contact_id in sorted(touched):
+            contact = self.contacts[contact_id]
+            with contextlib.nullcontext() if locked else contact.lock:
+                contact.event_locked(
+                    ContactEvent.PARAMETERS_REFUSED, now_ns, reason=f"parameter change refused: {reason}"
+                )
+        return SetParametersResult(successful=False, reason=reason)
 
     def destroy_node(self) -> None:
         # Stop the live thread first: it uses the subscriptions, timers and publishers. A step
@@ -1202,10 +1232,6 @@ def _retract_speed(value: float) -> float:
     if not low <= speed <= high:
         raise InputError(f"retract_speed must be in [{low:g}, {high:g}] m/s (got {speed:g})")
     return speed
-
-
-def _refuse(reason: str) -> SetParametersResult:
-    return SetParametersResult(successful=False, reason=reason)
 
 
 def freeze_start_up_objects() -> None:

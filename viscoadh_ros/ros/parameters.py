@@ -33,7 +33,9 @@ from rclpy.parameter import Parameter
 from viscoadh_ros.core.config import (
     COMMAND_QUEUE_DEPTH_MAX,
     CONTACT_KEYS,
+    DURATION_MAX_S,
     NODE_KEYS,
+    PHYSICAL_RANGES,
     PUBLISH_RATE_MAX,
     PUBLISH_RATE_MIN,
     SceneConfig,
@@ -176,7 +178,7 @@ _NODE_SPECS: dict[str, _Spec] = {
         "How far ahead of the node clock a command's header.stamp may be, s; a command stamped "
         "further ahead is rejected (it would move the contact's time).",
         low=0.0,
-        high=_INF,
+        high=DURATION_MAX_S,
     ),
     "command.queue_depth": _Spec(
         "Commands each command subscription (C/indentation, hand/indentation) holds for the "
@@ -198,7 +200,7 @@ _NODE_SPECS: dict[str, _Spec] = {
     "log.max_duration": _Spec(
         "Rotate the log file after this many seconds (0 = never), s.",
         low=0.0,
-        high=_INF,
+        high=DURATION_MAX_S,
         read_only=True,
     ),
     "log.queue_size": _Spec(
@@ -213,6 +215,18 @@ _NODE_SPECS: dict[str, _Spec] = {
 def is_scene_parameter(name: str) -> bool:
     """True for a parameter name that belongs to the scene (not one of rclpy's own)."""
     return name not in _RCLPY_PARAMETERS and not name.startswith(_RCLPY_PREFIXES)
+
+
+def not_a_scene_parameter(name: str) -> str:
+    """Why a runtime change of ``name`` (not part of the scene) is refused."""
+    if name == "use_sim_time":
+        return (
+            "use_sim_time is fixed at start-up: start the node with -p use_sim_time:=true "
+            "(a contact's time comes from its commands' stamps on the clock it started with)"
+        )
+    if name in _RCLPY_PARAMETERS or name.startswith(_RCLPY_PREFIXES):
+        return f"{name} is one of rclpy's own parameters, fixed at start-up"
+    return f"{name} is not a parameter of this node (see docs/ros_interface.md, Parameters)"
 
 
 def node_overrides(node: Node) -> dict[str, Any]:
@@ -284,10 +298,19 @@ def ros_parameter(name: str, value: Any) -> Parameter:
 def descriptor(name: str, parameter_type: int) -> ParameterDescriptor:
     """The ParameterDescriptor for a flat scene parameter: description, range, read_only."""
     spec = spec_for(name) or _Spec(f"Scene parameter {name} (see docs/ros_interface.md).")
+    _, _, leaf = name.partition(".")
+    physical = PHYSICAL_RANGES.get(leaf) if name not in _NODE_SPECS else None
+    description = spec.description
+    if physical is not None:
+        # The loader's range (both ends included), what a change is checked against; the
+        # spec's own low/high only say the sign ("> 0").
+        low, high, unit = physical
+        spec = _Spec(description, low=low, high=high, read_only=spec.read_only)
+        description += f" Allowed: [{low:g}, {high:g}]" + (f" {unit}" if unit else "") + "."
     desc = ParameterDescriptor(
         name=name,
         type=parameter_type,
-        description=spec.description,
+        description=description,
         read_only=spec.read_only,
     )
     if spec.low is not None and parameter_type == ParameterType.PARAMETER_DOUBLE:
