@@ -155,13 +155,26 @@ def gap(row: _kernels.Row, x: np.ndarray, depth: float, radius: float, interior:
 
 
 def force(row: _kernels.Row, radius: float, depth: float, points: int = 200001) -> float:
-    """2 E0* times the integral of the glass elongation over (0, a), dense trapezoid."""
+    """2 E0* times the integral of the glass elongation over (0, a), dense trapezoid. The
+    last interior element L counts with weight ``s = min(1, 2 (a - x_L) / dx)``, the memory
+    read without it (element L-1's extrapolation) with ``1 - s`` scaled by how relaxed element L-1's
+    unit memory is (`_kernels._edge_piece`, `_relaxed_share`)."""
     if radius <= 0.0:
         return 0.0
     x = np.linspace(0.0, radius, points)
     n_in = interior_count(radius, row.dx, row.elements)
-    w = side_values(row, x, row.wsum, row.bsum, 0, n_in - 1)
-    return 2.0 * row.e0 * trapezoid(depth - g_at(row, x) - w, x)
+
+    def integral(last: int) -> float:
+        w = side_values(row, x, row.wsum, row.bsum, 0, last)
+        return 2.0 * row.e0 * trapezoid(depth - g_at(row, x) - w, x)
+
+    s = min(1.0, 2.0 * (radius / row.dx - n_in + 0.5))
+    if n_in < 2 or s >= 1.0:
+        return integral(n_in - 1)
+    # The blend's share: 1 - CENTRE_CUT v tau / dx, v tau / dx = -1 / ln(1 - B_{L-1} / kap).
+    r = row.bsum[n_in - 2] / row.kap if row.kap > 0.0 else 1.0
+    c = 1.0 if r >= 1.0 else 0.0 if r <= 0.0 else max(0.0, 1.0 + _kernels.CENTRE_CUT / np.log1p(-r))
+    return integral(n_in - 1) + c * (1.0 - s) * (integral(n_in - 2) - integral(n_in - 1))
 
 
 def stored_energy(row: _kernels.Row, radius: float, depth: float, points: int = 200001) -> float:

@@ -208,7 +208,15 @@ def test_a_fit_after_the_change_with_a_scene_holds_what_the_change_set(log: Path
     done = fit_bag(str(log), {"scene": str(candidate), "free": "G0", "time_range": [after, 100.0]})
     assert done.changed_at is not None
     assert done.result.contact.adhesion.work_of_adhesion == 0.2
-    assert done.result.values["G0"] == pytest.approx(1.0e6, rel=1e-2), done.result.values
+    # Within 2 %: the log is noiseless, and the fit's grid (11136 elements) gives back G0 = 1e6
+    # to 1e-6 from the same log recorded at 8192 elements; what moves G0 is the node's own grid
+    # (`fast`, 64 elements) in the record. Measured (benchmarks/rounds/0.11.0-centre.md, session
+    # 12): 0.11.0's record, whose force dipped at each element-centre crossing, +0.43 %; the same
+    # with the 12 rows the centre-crossing blend moves set to 8192 elements' force +1.82 %, with
+    # all its other rows so set instead -1.36 % (the dips offset the rest: the old 1 % bound held
+    # by that); with the blend +1.40 %. The bound is that grid's error, not the fit's; the held
+    # work of adhesion is checked above.
+    assert done.result.values["G0"] == pytest.approx(1.0e6, rel=2e-2), done.result.values
 
 
 def test_plot_draws_the_reference_of_the_scene_in_force(
