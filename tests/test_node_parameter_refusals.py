@@ -28,7 +28,7 @@ from rclpy.parameter import Parameter
 from viscoadh_msgs.msg import ContactEvent, ContactState, IndentationCommand
 from viscoadh_msgs.srv import PredictPullOff
 
-from tests.test_node_process import SCENE, START_TIMEOUT, TIMEOUT, VISCOADH
+from tests.test_node_process import SCENE, START_TIMEOUT, TIMEOUT, VISCOADH, run_node_process
 from viscoadh_ros.core.config import SceneConfig
 from viscoadh_ros.core.simulator import ContactSimulator
 from viscoadh_ros.ros.conversions import ns_to_stamp
@@ -49,24 +49,7 @@ def _string(name: str, value: str) -> ParameterMsg:
 
 @pytest.fixture
 def node_process(tmp_path: Path, ros_env: dict[str, str]) -> Any:
-    params = tmp_path / "scene.yaml"
-    params.write_text(yaml.safe_dump(SCENE))
-    log = (tmp_path / "node.log").open("w")
-    process = subprocess.Popen(
-        [str(VISCOADH), "node", "--ros-args", "--params-file", str(params), "-p", "publish_rate:=2.0"],
-        env=ros_env,
-        stdout=log,
-        stderr=subprocess.STDOUT,
-    )
-    yield process
-    if process.poll() is None:
-        process.send_signal(signal.SIGINT)
-        try:
-            process.wait(timeout=10.0)
-        except subprocess.TimeoutExpired:
-            process.kill()
-            process.wait(timeout=5.0)
-    log.close()
+    yield from run_node_process(tmp_path, ros_env)
 
 
 def test_a_bad_runtime_change_is_refused_and_the_node_keeps_serving(

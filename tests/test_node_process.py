@@ -51,8 +51,9 @@ SCENE = {
 }
 
 
-@pytest.fixture
-def node_process(tmp_path: Path, ros_env: dict[str, str]) -> Any:
+def run_node_process(tmp_path: Path, ros_env: dict[str, str]) -> Any:
+    """`viscoadh node` on SCENE as a child process (output in ``tmp_path/node.log``), yielded
+    and stopped afterwards; the body of the ``node_process`` fixtures."""
     params = tmp_path / "scene.yaml"
     params.write_text(yaml.safe_dump(SCENE))
     log = (tmp_path / "node.log").open("w")
@@ -71,6 +72,11 @@ def node_process(tmp_path: Path, ros_env: dict[str, str]) -> Any:
             process.kill()
             process.wait(timeout=5.0)
     log.close()
+
+
+@pytest.fixture
+def node_process(tmp_path: Path, ros_env: dict[str, str]) -> Any:
+    yield from run_node_process(tmp_path, ros_env)
 
 
 def test_node_process_serves_a_controller_like_the_core(
