@@ -16,7 +16,7 @@ from scenes import one_contact
 
 from viscoadh_ros.core.config import ContactConfig, SceneConfig, load_default_scene
 from viscoadh_ros.core.history import simulate_history
-from viscoadh_ros.core.simulator import RESOLUTION_FINE_CELLS, ContactSimulator, Phase
+from viscoadh_ros.core.simulator import RESOLUTION_ELEMENTS, ContactSimulator, Phase
 
 #: Press to 100 um over 20 s and pull to -50 um (the tester's history, 4 ms rows cut to 20 ms).
 TIME = np.linspace(0.0, 40.0, 801)
@@ -58,7 +58,7 @@ def test_a_domain_far_wider_than_the_contact_is_flagged(domain_radius: float) ->
     seen = _validity_along(_default(domain_radius=domain_radius), pressing=True)
     assert len(seen) > 100 and all(not v.ok and not v.resolution_ok for v in seen)
     assert all("numerics.domain_radius" in v.message for v in seen)
-    assert all(v.elements_in_contact < RESOLUTION_FINE_CELLS / 32 for v in seen)
+    assert all(v.elements_in_contact < RESOLUTION_ELEMENTS for v in seen)
 
 
 def test_the_scene_chosen_domain_resolves_every_state() -> None:
@@ -80,14 +80,38 @@ def test_auto_domains_resolve_presses_of_every_preset(indenter: dict, work: floa
         assert seen and all(v.resolution_ok for v in seen), (preset, min(v.elements_in_contact for v in seen))
 
 
+#: The second outside tester's history (0.12.0): pressed to 100 um in 2 s, pulled to -50 um.
+FAST_TIME = np.linspace(0.0, 4.0, 401)
+FAST_DEPTH = np.interp(FAST_TIME, [0.0, 2.0, 4.0], [0.0, 100e-6, -50e-6])
+
+
+@pytest.mark.parametrize("numerics", [{"domain_radius": 0.05}, {"elements": 4}, {"elements": 12}])
+def test_a_contact_a_few_elements_wide_is_flagged(numerics: dict) -> None:
+    """A contact 1-6 elements wide (the second tester: 3 % off at pull-off, 8-11 % of the
+    pull-off force on the press) was passed by the first rule (8 fine cells)."""
+    reference = simulate_history(_default(elements=8192), FAST_TIME, depth=FAST_DEPTH)
+    coarse = simulate_history(_default(**numerics), FAST_TIME, depth=FAST_DEPTH)
+    pull_off = -reference.force.min()
+    assert np.max(np.abs(coarse.force - reference.force)) > 5e-2 * pull_off
+    simulator = ContactSimulator(_default(**numerics))
+    flagged = 0
+    for t, d in zip(FAST_TIME[1:], FAST_DEPTH[1:], strict=True):
+        out = simulator.step(float(t), depth=float(d))
+        validity = simulator.model_validity
+        if simulator.in_contact and out.phase != Phase.DETACHING:
+            assert validity.elements_in_contact < RESOLUTION_ELEMENTS or validity.resolution_ok
+            flagged += not validity.resolution_ok
+    assert flagged > 0, numerics
+
+
 def test_a_resolved_wide_domain_is_not_flagged() -> None:
-    # 1 m over 160 elements against a contact of ~0.7 mm at its deepest is 3.7 fine cells
-    # (flagged above); 0.1 m is 37: resolved, and the pull-off within the preset's bound.
+    # 0.1 m over 160 elements puts the deepest contact (~0.7 mm) across 1.2 elements: flagged;
+    # 0.01 m, 11.7 elements: resolved at its deepest, the pull-off within the preset's bound.
     auto = simulate_history(_default(), TIME, depth=DEPTH)
-    wide = simulate_history(_default(domain_radius=0.1), TIME, depth=DEPTH)
+    wide = simulate_history(_default(domain_radius=0.01), TIME, depth=DEPTH)
     assert abs(wide.force.min() - auto.force.min()) < 1e-2 * -auto.force.min()
-    deepest = _validity_along(_default(domain_radius=0.1))
-    assert max(v.elements_in_contact for v in deepest) > RESOLUTION_FINE_CELLS / 32
+    deepest = _validity_along(_default(domain_radius=0.01))
+    assert max(v.elements_in_contact for v in deepest) > RESOLUTION_ELEMENTS
     assert deepest[len(deepest) // 2].resolution_ok
 
 
