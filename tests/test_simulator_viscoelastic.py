@@ -410,3 +410,32 @@ def test_scalar_scale_separation_agrees_with_the_criterion_module() -> None:
         assert physics.scale_separation_ok(speed) == bool(
             scale_separation_holds(speed, physics.critical_speeds)
         ), f"edge_speed={speed!r} (v_c1={v_c1!r}, v_c2={v_c2!r})"
+
+
+@pytest.mark.parametrize(
+    "kelvin", [(), (5e4,)], ids=["elastic (closed form)", "standard solid (time-stepped)"]
+)
+def test_predict_pull_off_of_a_non_adhesive_contact_reports_where_it_let_go(kelvin) -> None:
+    """Never tensile (w = 0): `pull_off_depth` is the let-go depth, not the start depth (a
+    second outside tester, 0.12.0: 1e-5 m reported for a contact that let go at 3.7e-6 m)."""
+    contact = one_contact(
+        {"shape": "sphere", "radius": 5e-3}, kelvin=kelvin, viscosities=(1.05e5,) * len(kelvin), work=0.0
+    )
+    simulator = ContactSimulator(contact)
+    simulator.step(0.0, depth=0.0)
+    simulator.step(0.1, depth=1e-5)
+    speed = 1e-3
+    prediction = predict_pull_off(simulator, speed)
+    assert prediction.detached and prediction.pull_off_force == 0.0
+    assert prediction.pull_off_depth == pytest.approx(1e-5 - speed * prediction.time_to_detach, abs=1e-15)
+    # The same retraction stepped in fine rows lets go there.
+    t = 0.1 + np.linspace(0.0, 0.02, 20001)[1:]
+    rows = simulate_history(
+        contact,
+        np.concatenate([[0.0, 0.1], t]),
+        depth=np.concatenate([[0.0, 1e-5], 1e-5 - speed * (t - 0.1)]),
+    )
+    let_go = rows.depth[2:][np.argmax(rows.contact_radius[2:] == 0.0)]
+    assert prediction.pull_off_depth == pytest.approx(let_go, abs=2e-9)
+    if kelvin:
+        assert prediction.pull_off_depth > 1e-6, "the creeping surface lags: it lets go above 0"

@@ -371,7 +371,7 @@ def format_summary(summary: DemoSummary, files: dict[str, Path]) -> str:
     if outward > 1.05 * inward:
         way_in, way_out = "weak on the way in", "strong on the way out"
     else:
-        way_in = way_out = "about the same both ways (no memory to strengthen the release)"
+        way_in = way_out = "about the same both ways"
     loop, lost = summary.loop_energy, summary.dissipated_energy
     if abs(loop - lost) <= 1e-2 * max(abs(loop), abs(lost)):
         stored = "the same within 1 %: nothing is left stored"

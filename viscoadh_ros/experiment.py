@@ -780,6 +780,7 @@ class Material:
     #: from the node's before the change.
     replaced: dict[str, Any] = field(default_factory=dict)
     given: bool = False  # True: the change applied to the user's scene; False: the node's contact
+    order: int | None = None  # the event's position in the recording (None: the record's start)
 
     def _at(self, experiment: Experiment) -> float:
         """Record time of the change, s (0 for the record's start; < 0 before its first input)."""
@@ -792,9 +793,12 @@ class Material:
             return f"t = {at:.6g} s on: {start}"
         change = ", ".join(f"{k} {_value_text(a)} -> {_value_text(b)}" for k, (a, b) in self.changed.items())
         change = f"the logged parameter change {change or '(nothing of this contact)'}"
-        # A change made before the record's first input has a negative record time (an outside
-        # tester read "t = -0.073 s" as a fault): say what it means.
-        before = " (before the first input)" if at < 0.0 else ""
+        # A change made before the record's first input (in recording order: after a reset the
+        # stamps may start over) has a negative record time (an outside tester read
+        # "t = -0.073 s" as a fault): say what it means.
+        first = int(experiment.input_order[0]) if experiment.input_order.size else None
+        early = first is not None and self.order is not None and self.order < first
+        before = " (before the first input)" if early else ""
         text = f"t = {at:.6g} s{before} on: " + (
             f"{change} applied to the --scene contact" if self.given else f"the node's contact after {change}"
         )
@@ -876,7 +880,7 @@ def materials(
                     f"the logged parameter change at t = {at:.6g} s ({', '.join(changed) or 'nothing'}) "
                     f"cannot apply to the --scene contact {contact.id!r}: {exc}"
                 ) from None
-        found.append(Material(current, restart.ns, changed, replaced, given))
+        found.append(Material(current, restart.ns, changed, replaced, given, restart.order))
         node_before = node_after
     return found
 

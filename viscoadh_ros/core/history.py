@@ -136,8 +136,9 @@ class PullOffPrediction:
     """Outcome of a constant-speed retraction from the current state.
 
     pull_off_force: the most tensile force reached, N (0 if never tensile); pull_off_depth:
-    the depth where it was reached, m; time_to_detach: from the start of the retraction to
-    full detachment, s (the time the retraction ran if it did not detach); detached: whether
+    the depth where it was reached (never tensile: where the contact let go), m;
+    time_to_detach: from the start of the retraction to full detachment, s (the time the
+    retraction ran if it did not detach); detached: whether
     the contact let go; message: what happened, including a limit that stopped the run.
     """
 
@@ -250,6 +251,10 @@ def predict_pull_off(simulator: ContactSimulator, retract_speed: float) -> PullO
                 break
     finally:
         simulator.restore(start)
+    if detached and not best[0] < 0.0:
+        # Never tensile (no adhesion): nothing was pulled, and the depth that matters is where
+        # the contact let go (the start depth was reported: a second outside tester, 0.12.0).
+        best[1] = d0 - speed * elapsed
     if detached:
         message = f"detached after {elapsed:.6g} s of retraction at {speed:g} m/s"
     else:
