@@ -417,6 +417,13 @@ class _TimeStepped:
         # without it). A longer step is refused before the kernel runs (`advance`, the lean
         # paths of `ContactSimulator.step` leave it to `advance`).
         self._longest_step = self._max_substep * MAX_SUBSTEPS if self._max_substep > 0.0 else math.inf
+        # The constants every kernel call reads (`_kernels.step_params`: those two and, for the
+        # derived outputs, E_r* and the critical edge speeds), passed as one address.
+        v_c1, v_c2 = (float(v) for v in physics.critical_speeds)
+        self._params = _kernels.step_params(
+            self._max_substep, self._max_edge_cells, float(physics.e_relaxed), v_c1, v_c2
+        )
+        self._params_address = self._params.ctypes.data
         # The compiled step (`_kernels._step_packed`) called through its entry point; loaded
         # (or compiled) with the first time-stepped model.
         global _STEP
@@ -500,6 +507,16 @@ class _TimeStepped:
         # The fine point where the glass modulus' JKR curve on the first domain has its
         # force minimum (`glass_contact`), found on first use.
         self._glass_lowest: int | None = None
+
+    def __getstate__(self) -> dict:
+        # A copy (pickle, deepcopy) has its own `_params`: its address is found again on load.
+        state = dict(self.__dict__)
+        del state["_params_address"]
+        return state
+
+    def __setstate__(self, state: dict) -> None:
+        self.__dict__.update(state)
+        self._params_address = self._params.ctypes.data
 
     # -- the domain ---------------------------------------------------------------------
     def _build_row(
@@ -825,25 +842,25 @@ class _TimeStepped:
             # The kernel itself, not the validating wrapper: the row's arrays are checked
             # when built, the step's scalars by ContactSimulator.step.
             # (`_step_packed`'s phase and speed outputs are not needed here: `_publish` makes them.)
+            # The step's own work (-0.0 + work) and the dissipated energy's new total.
             state, const = row.addresses
             result = _STEP(
                 state,
                 const,
+                self._params_address,
                 journal,
                 self.radius,
                 d0,
                 d1,
                 dt,
-                self._max_substep,
-                self._max_edge_cells,
                 force_prev,
                 self.radius,
-                0.0,
-                0.0,
-                0.0,
+                -0.0,
+                dissipated0,
             )
             journal = False
-            if result[0] == _kernels.STATUS_OK:
+            if result[0] != _kernels.STATUS_GROW:
+                # (STATUS_OVERFLOW too: the caller refuses a step whose energies overflow.)
                 break
             force_prev = math.nan  # a new row after the growth
             if start is None:
@@ -853,7 +870,7 @@ class _TimeStepped:
             self.radius, self.dissipated = radius0, dissipated0
             self._grow(d0)
             start = self.get_state()
-        self._stepped(row, result, d1, dissipated0)
+        self._stepped(row, result, d1)
         return result[1], result[2], result[3]
 
     def let_go_depth(self) -> float:
@@ -871,13 +888,14 @@ class _TimeStepped:
             return known[3]
         return math.nan
 
-    def _stepped(self, row: _kernels.Row, result: tuple, d1: float, dissipated0: float) -> None:
+    def _stepped(self, row: _kernels.Row, result: tuple, d1: float) -> None:
         """The model's fields after a kernel call on `row` that stepped to depth `d1` (m):
-        `result` is `_STEP`'s tuple, `dissipated0` the energy dissipated before the call (J)."""
+        `result` is `_STEP`'s tuple (given the energy dissipated before the call: its new
+        total)."""
         radius = result[1]
         self.radius = radius
         self.substeps = result[4]
-        self.dissipated = dissipated0 + result[5]
+        self.dissipated = result[5]
         self._memory_peak = result[6]
         self._edge = result[7]
         self._edge_depth = d1
@@ -1460,9 +1478,6 @@ class ContactSimulator:
         else:
             first = _first_domain(self.physics, self.numerics)
         self._depth_limit = _largest_domain(first)
-        # The physics constants the compiled step derives its outputs from (`_STEP`).
-        self._e_relaxed = float(self.physics.e_relaxed)
-        self._v_c1, self._v_c2 = (float(v) for v in self.physics.critical_speeds)
         self.reset(0.0)
 
     # -- public state ---------------------------------------------------------------------
@@ -1665,13 +1680,15 @@ class ContactSimulator:
                     model._journal = None
                     try:
                         model._journal = row
+                        # The energy input and dissipated energy after the step come back
+                        # summed (energy0 + work, dissipated0 + the step's losses) and checked.
                         (
                             status,
                             radius,
                             f,
-                            work,
+                            energy,
                             substeps,
-                            step_dissipated,
+                            dissipated,
                             peak,
                             edge,
                             phase,
@@ -1681,24 +1698,18 @@ class ContactSimulator:
                         ) = _STEP(
                             state,
                             const,
+                            model._params_address,
                             True,
                             radius0,
                             d_prev,
                             d,
                             dt,
-                            model._max_substep,
-                            model._max_edge_cells,
                             force_prev,
                             r0,
-                            self._e_relaxed,
-                            self._v_c1,
-                            self._v_c2,
+                            energy0,
+                            dissipated0,
                         )
                         if status == 0:  # _kernels.STATUS_OK
-                            energy = energy0 + work
-                            dissipated = dissipated0 + step_dissipated
-                            if not (energy - energy == 0.0 and dissipated - dissipated == 0.0):
-                                raise _overflow(energy, dissipated)
                             # The output first (nothing changed yet if it fails), then the
                             # commit. Filling the instance's dict item by item is cheaper than
                             # a dict display (`_new_output`).
@@ -1734,6 +1745,8 @@ class ContactSimulator:
                             self._output = output
                             self._held_force = None
                             return output
+                        if status == _kernels.STATUS_OVERFLOW:
+                            raise _overflow(energy, dissipated)
                         _kernels._restore_state(row.wl, row.wsum, row.wb, row.bsum, row.txn, row.txn_b)
                         model._journal = None
                     except BaseException:
@@ -1857,8 +1870,7 @@ class ContactSimulator:
             first = d0 + (target - f0 - memo[2] * dt) / slope
         bend = memo[3]
         state, const = row.addresses
-        max_substep, max_edge_cells = model._max_substep, model._max_edge_cells
-        e_relaxed, v_c1, v_c2 = self._e_relaxed, self._v_c1, self._v_c2
+        params = model._params_address
         token = model.begin()
         start = model.trial_start()
         radius0, dissipated0 = model.radius, model.dissipated
@@ -1893,28 +1905,28 @@ class ContactSimulator:
                         break
                 model._force_at = None
                 model._journal = row
+                # (The trial's own work, -0.0 + work; the dissipated energy's new total.)
                 result = _STEP(
                     state,
                     const,
+                    params,
                     True,
                     radius0,
                     d0,
                     x_new,
                     dt,
-                    max_substep,
-                    max_edge_cells,
                     force_prev,
                     r_before,
-                    e_relaxed,
-                    v_c1,
-                    v_c2,
+                    -0.0,
+                    dissipated0,
                 )
                 force_prev = math.nan
-                if result[0] != 0:  # not _kernels.STATUS_OK: the domain must grow
+                if result[0] == _kernels.STATUS_GROW:  # the domain must grow
+                    # (STATUS_OVERFLOW is a step: `_publish` below refuses it as before.)
                     result = None
                     grow = True
                     break
-                model._stepped(row, result, x_new, dissipated0)
+                model._stepped(row, result, x_new)
                 radius, f = result[1], result[2]
                 trials.append((x_new, f, radius))
                 last = [x_new, (radius, f, result[3])]
