@@ -12,15 +12,18 @@ per call. The two cores' outputs are compared field by field on every timed row 
 floats by their bits, so a -0.0 against 0.0 counts as a difference).
 
     git worktree add --detach /work/ab/<name>-base main
-    PYTHONPATH=. .venv/bin/python benchmarks/percall_ab.py /work/ab/<name>-base [repeats] [N,K ...]
+    PYTHONPATH=. .venv/bin/python benchmarks/percall_ab.py [--new-first] /work/ab/<name>-base \
+        [repeats] [N,K ...]
 
 (default repeats 21; default scenes N = 64, 256, 1024, 2048, 4096 at K = 0, 1, 4). An A/A run
-(the same checkout as old and new) shows the noise of a sitting.
+(the same checkout as old and new) shows the noise of a sitting. Where each core's compiled code
+lands in memory moves a K = 4 step at N >= 1024 by up to ~4 % either way, and it follows the
+order the cores are loaded in (0.12.0 `percall`: the same two kernels read 1.02-1.04 and
+0.97 the other way round): `--new-first` loads this checkout's core first; run both orders.
 """
 
 from __future__ import annotations
 
-import importlib
 import os
 import struct
 import sys
@@ -29,10 +32,13 @@ import ab_cores
 import numpy as np
 
 here = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-roots = {"old": os.path.abspath(sys.argv[1]), "new": here}
-repeats = int(sys.argv[2]) if len(sys.argv) > 2 else 21
-if len(sys.argv) > 3:
-    SIZES = [tuple(int(x) for x in arg.split(",")) for arg in sys.argv[3:]]
+argv = [arg for arg in sys.argv[1:] if arg != "--new-first"]
+roots = {"old": os.path.abspath(argv[0]), "new": here}
+if "--new-first" in sys.argv:
+    roots = {"new": here, "old": roots["old"]}
+repeats = int(argv[1]) if len(argv) > 1 else 21
+if len(argv) > 2:
+    SIZES = [tuple(int(x) for x in arg.split(",")) for arg in argv[2:]]
 else:
     SIZES = [(n, k) for k in (0, 1, 4) for n in (64, 256, 1024, 2048, 4096)]
 ROWS = 100  # `bench.kernel.STEP_TIMING_STEPS`
@@ -40,7 +46,7 @@ ROWS = 100  # `bench.kernel.STEP_TIMING_STEPS`
 cores = {}
 for label, root in roots.items():
     cores[label] = ab_cores.load(root, rename_kernels=label == "old")
-    cores[label]["hand"] = importlib.import_module("viscoadh_ros.core.hand")
+cores = {"old": cores["old"], "new": cores["new"]}  # run and print in this order either way
 new_bench = cores["new"]["bench_kernel"]
 interleaved_medians = new_bench.interleaved_medians
 MinimalStepper = new_bench.MinimalStepper
