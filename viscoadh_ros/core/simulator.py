@@ -1655,17 +1655,19 @@ class ContactSimulator:
                     edge0 = model._edge
                     edge_depth0 = model._edge_depth
                     known = model._force_at
-                    # `_TimeStepped.advance`'s rule for the force known at the start.
-                    if (
-                        known is not None
-                        and known[0] is row
-                        and known[1] == radius0
-                        and known[2] == d_prev
-                        and d_prev != 0.0
-                    ):
-                        force_prev = known[3]
-                    else:
+                    # `_TimeStepped.advance`'s rule for the force known at the start (the
+                    # tuple unpacked: four subscripts cost more).
+                    if known is None:
                         force_prev = math.nan
+                    else:
+                        known_row, known_radius, known_depth, force_prev = known
+                        if not (
+                            known_row is row
+                            and known_radius == radius0
+                            and known_depth == d_prev
+                            and d_prev != 0.0
+                        ):
+                            force_prev = math.nan
                     state, const = row.addresses
                     energy0 = self._energy_input
                     held0 = self._held_force
