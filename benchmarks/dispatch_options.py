@@ -80,8 +80,20 @@ def _two_buffers_unpacked(state, const, journal, a, d0, d1, dt, ms, me):
 
 @numba.njit(nogil=True)
 def _two_addresses(state, const, journal, a, d0, d1, dt, ms, mc, fp, r0, er, v1, v2):
-    # `_kernels._step_packed`'s signature and the shape of its result (a tuple of scalars).
+    # `_kernels._step_packed`'s signature up to 0.11.0 and the shape of its result (a tuple of
+    # scalars).
     return (0, a, d0, d1, 1, dt, ms, (mc, fp, r0), 1, er, v1 + v2, journal)
+
+
+#: `_two_addresses`'s argument types (`_kernels._STEP_SIGNATURE` up to 0.11.0).
+_TWO_ADDRESSES = (numba.types.intp, numba.types.intp, numba.types.boolean) + (numba.types.float64,) * 11
+
+
+@numba.njit(nogil=True)
+def _three_addresses(state, const, params, journal, a, d0, d1, dt, fp, r0, e0, x0):
+    # `_kernels._step_packed`'s signature since 0.12.0 (the model's constants behind a third
+    # address) and the shape of its result.
+    return (0, a, d0, d1 + e0, 1, dt + x0, fp, (r0, fp, r0), 1, a, d0, journal)
 
 
 def main() -> None:
@@ -102,8 +114,10 @@ def main() -> None:
         return run
 
     addresses = row.addresses
-    entry = _two_addresses.compile(_kernels._STEP_SIGNATURE)
+    entry = _two_addresses.compile(_TWO_ADDRESSES)
     step_args = (*addresses, True, 1.0, 2.0, 3.0, 1e-3, 0.0, 1.0, 0.5, 1.0, 2.0, 3.0, 4.0)
+    entry3 = _three_addresses.compile(_kernels._STEP_SIGNATURE)
+    step_args3 = (*addresses, sim._model._params_address, True, 1.0, 2.0, 3.0, 1e-3, 0.5, 1.0, 2.0, 3.0)
     options = {
         "32 arguments (20 arrays, 12 floats): _advance's signature": loop(
             lambda: _args32(*args, 1.0, 2.0, 3.0, 1e-3, 0.0, 1e-6)
@@ -131,10 +145,13 @@ def main() -> None:
         "2 buffers + bool + 6 floats, views by _unpack (carray)": loop(
             lambda: _two_buffers_unpacked(state, const, True, 1.0, 2.0, 3.0, 1e-3, 0.0, 1e-6)
         ),
-        "2 addresses + bool + 11 floats, a 12-tuple returned (`_step_packed`), dispatcher": loop(
+        "2 addresses + bool + 11 floats, a 12-tuple returned (`_step_packed` to 0.11.0), dispatcher": loop(
             lambda: _two_addresses(*step_args)
         ),
-        "the same through its entry point (`_kernels.step_entry`)": loop(lambda: entry(*step_args)),
+        "the same through its entry point (`_kernels.step_entry` to 0.11.0)": loop(lambda: entry(*step_args)),
+        "3 addresses + bool + 8 floats, a 12-tuple returned, entry point (`_step_packed` 0.12.0)": loop(
+            lambda: entry3(*step_args3)
+        ),
         "empty Python loop (lambda call)": loop(lambda: None),
     }
     for run in options.values():

@@ -184,6 +184,42 @@ def test_the_packed_views_are_the_rows_kernel_arguments(kelvin: int) -> None:
     assert np.shares_memory(clone.gf, row.gf)
 
 
+def test_the_step_params_address_is_the_models_own() -> None:
+    """`_step_packed` reads the model's constants at `_TimeStepped._params_address` (0.12.0): the
+    model's own `_params` array (max_substep, max_edge_cells, E_r*, v_c1, v_c2 as the model and
+    the physics give them), also for a pickled or deep-copied simulator, which steps as the
+    original does."""
+    contact = one_contact(
+        {"shape": "sphere", "radius": 0.005},
+        kelvin=[1e5],
+        viscosities=[1e3],
+        work=0.05,
+        numerics={"elements": 40, "model": "time_stepped"},
+    )
+    sim = ContactSimulator(contact)
+    for k in range(1, 20):
+        sim.step(k * 1e-3, depth=k * 1e-6)
+    model = sim._model
+    v_c1, v_c2 = sim.physics.critical_speeds
+    assert model._params.tolist() == [
+        model._max_substep,
+        model._max_edge_cells,
+        float(sim.physics.e_relaxed),
+        float(v_c1),
+        float(v_c2),
+    ]
+    copies = [pickle.loads(pickle.dumps(sim)), copy.deepcopy(sim)]
+    for candidate in (sim, *copies):
+        params = candidate._model._params
+        assert candidate._model._params_address == params.ctypes.data
+    assert copies[0]._model._params_address != model._params_address
+    assert copies[1]._model._params_address != model._params_address
+    for k in range(20, 40):
+        want = _bits(sim.step(k * 1e-3, depth=(40 - k) * 1e-6))
+        for candidate in copies:
+            assert _bits(candidate.step(k * 1e-3, depth=(40 - k) * 1e-6)) == want
+
+
 def _bits(output) -> tuple:
     """An output's fields as bits (phase and flags by value)."""
     return tuple(np.array([float(getattr(output, name)) for name in STEP_OUTPUT_FIELDS]).view(np.uint64))

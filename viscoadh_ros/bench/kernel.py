@@ -417,15 +417,15 @@ def _row_work(contact: Any, times, values, key: str) -> tuple[npt.NDArray[np.int
     kernel substeps of those trials together, per row, on a fresh simulator. Counted at the
     compiled step every path calls (`simulator._STEP`: the lean depth and force paths and
     `_TimeStepped.advance`): a trial is a kernel call that stepped (one that stopped for a
-    domain growth is not, its substeps count); a row with no call (idle above the surface) is
-    one trial of no substep."""
+    domain growth is not, its substeps count; one whose energies overflow, STATUS_OVERFLOW,
+    stepped); a row with no call (idle above the surface) is one trial of no substep."""
     simulator = ContactSimulator(contact)  # loads the compiled step
     counted = [0, 0]
     kernel_step = simulator_module._STEP
 
     def counting_step(*args: Any) -> Any:
         result = kernel_step(*args)
-        counted[0] += result[0] == _kernels.STATUS_OK
+        counted[0] += result[0] != _kernels.STATUS_GROW
         counted[1] += int(result[4])
         return result
 

@@ -61,6 +61,17 @@ STATUS_OK = 0
 STATUS_GROW = 1
 #: `_advance_rows` stopped before a row that starts from an idle contact (Python drops it).
 STATUS_IDLE = 2
+#: `_step_packed`: the step ran (as STATUS_OK) but its energy input or dissipated energy is not
+#: finite (the simulator refuses the step and rolls it back).
+STATUS_OVERFLOW = 3
+
+#: `_step_packed`'s per-model constants (`step_params`), by index.
+PARAM_MAX_SUBSTEP = 0
+PARAM_MAX_EDGE_CELLS = 1
+PARAM_E_RELAXED = 2
+PARAM_V_C1 = 3
+PARAM_V_C2 = 4
+PARAM_SIZE = 5
 
 #: Edge motion codes written to ``out[OUT_MOTION]`` by `advance`.
 MOTION_NONE = 0
@@ -4270,31 +4281,38 @@ def _derived_outputs(radius, r0, rest, d1, dt, outside, inside, g_edge, c_crit, 
 # count). Its return value is a tuple of scalars: boxing it costs less than reading the same
 # values back from ``out`` in Python.
 @numba.njit(cache=True, nogil=True)
-def _step_packed(
-    state, const, journal, a, d0, d1, dt, max_substep, max_edge_cells, force_prev, r0, e_relaxed, v_c1, v_c2
-):
+def _step_packed(state, const, params, journal, a, d0, d1, dt, force_prev, r0, energy0, dissipated0):
     """`_advance_packed` on the row whose buffers are at addresses `state` and `const`
-    (`Row.addresses`; the caller holds the row for the whole call), `journal`, `a` .. `dt`,
-    `max_substep` and `force_prev` as there, the edge limit given as ``max_edge_cells``
-    elements of this row; then the step's derived outputs from the kernel's ``out`` slots,
-    computed as `simulator._phase` and `ContactSimulator.step` computed them in Python (the
-    same IEEE operations in the same order: the same bits). The simulator's one kernel call
-    per step or force trial. Addresses rather than arrays: numba unboxes an array argument
-    in about 0.14 us, an integer in a few ns.
+    (`Row.addresses`; the caller holds the row for the whole call), `journal`, `a` .. `dt`
+    and `force_prev` as there, the model's constants at address `params` (`step_params`:
+    max_substep as there, the edge limit as ``max_edge_cells`` elements of this row, and
+    for the derived outputs the relaxed modulus E_r*, Pa, and the critical edge speeds
+    v_c1, v_c2 (advancing, receding), m/s); then the step's derived outputs from the
+    kernel's ``out`` slots, computed as `simulator._phase` and `ContactSimulator.step`
+    computed them in Python (the same IEEE operations in the same order: the same bits).
+    The simulator's one kernel call per step or force trial. Addresses rather than arrays:
+    numba unboxes an array argument in about 0.14 us, an integer in a few ns; the constants
+    behind one address rather than five floats (0.12.0 `percall`: each argument is unboxed
+    every call).
 
-    r0: the contact radius before the step (the last output's), m; e_relaxed: the relaxed
-    modulus E_r*, Pa; v_c1, v_c2: the critical edge speeds (advancing, receding), m/s.
+    r0: the contact radius before the step (the last output's), m; energy0, dissipated0: the
+    energy input and the energy dissipated before the step, J (-0.0 each: the step's own
+    work and losses, since ``-0.0 + x`` is x for every float x).
 
-    Returns ``(status, radius, force, work, substeps, dissipated, memory_peak, (gap_outside,
-    gap_inside, g_edge), phase, edge_speed, effective_work, scale_separation_ok)``: the
-    ``out`` slots (``dissipated``: over this step), the phase code (``PHASE_*``), and, when
-    status is not STATUS_OK, outputs of a partial step that the caller discards (it
-    restores the memory from the journal)."""
+    Returns ``(status, radius, force, energy0 + work, substeps, dissipated0 + dissipated,
+    memory_peak, (gap_outside, gap_inside, g_edge), phase, edge_speed, effective_work,
+    scale_separation_ok)``: the ``out`` slots (``dissipated``: over this step) with the
+    sums the simulator forms (the same additions it made in Python), the phase code
+    (``PHASE_*``); status STATUS_OVERFLOW for a step that ran but whose two sums are not
+    both finite. When status is STATUS_GROW, outputs of a partial step that the caller
+    discards (it restores the memory from the journal)."""
     args, txn, txn_b = _unpack_at(state, const)
+    constants = _view(params, 0, PARAM_SIZE)
     if journal:
         _copy_state(args[0], args[2], txn, txn_b)
     dx = args[8]
-    max_edge_move = max_edge_cells * dx
+    max_substep = constants[PARAM_MAX_SUBSTEP]
+    max_edge_move = constants[PARAM_MAX_EDGE_CELLS] * dx
     if math.isnan(force_prev):
         status = _advance(*args, a, d0, d1, dt, max_substep, max_edge_move)
     else:
@@ -4302,22 +4320,36 @@ def _step_packed(
             *args, a, d0, d1, dt, max_substep, max_edge_move, force_prev, txn[:0], txn_b[:0]
         )
     out = args[25]
+    energy = energy0 + out[OUT_WORK]
+    dissipated = dissipated0 + out[OUT_DISSIPATED]
+    if status == STATUS_OK and not (math.isfinite(energy) and math.isfinite(dissipated)):
+        status = STATUS_OVERFLOW
     radius = out[OUT_RADIUS]
     outside = out[OUT_GAP_OUTSIDE]
     inside = out[OUT_GAP_INSIDE]
     g_edge = out[OUT_G_EDGE] if radius > 0.0 else 0.0
     # `simulator._phase`: an edge that moved less than twice its location tolerance is at rest.
     phase, edge_speed, effective, separated = _derived_outputs(
-        radius, r0, 2.0 * EDGE_TOLERANCE * dx, d1, dt, outside, inside, g_edge, args[16], e_relaxed, v_c1,
-        v_c2,
+        radius,
+        r0,
+        2.0 * EDGE_TOLERANCE * dx,
+        d1,
+        dt,
+        outside,
+        inside,
+        g_edge,
+        args[16],
+        constants[PARAM_E_RELAXED],
+        constants[PARAM_V_C1],
+        constants[PARAM_V_C2],
     )
     return (
         status,
         radius,
         out[OUT_FORCE],
-        out[OUT_WORK],
+        energy,
         int(out[OUT_SUBSTEPS]),
-        out[OUT_DISSIPATED],
+        dissipated,
         out[OUT_MEMORY],
         (outside, inside, out[OUT_G_EDGE]),
         phase,
@@ -4396,18 +4428,32 @@ def _batch_columns(
 
 #: `_step_packed`'s argument types: its one compiled version, whose entry point
 #: (`step_entry`) the simulator calls directly.
-_STEP_SIGNATURE = (types.intp, types.intp, types.boolean) + (types.float64,) * 11
+_STEP_SIGNATURE = (types.intp, types.intp, types.intp, types.boolean) + (types.float64,) * 8
 
 
 @functools.cache
 def step_entry():
     """`_step_packed`'s compiled entry point for `_STEP_SIGNATURE`, called without numba's
     dispatcher: the dispatcher types every argument to pick the version (about 0.3 us of a
-    0.6 us call with these 14 arguments, `benchmarks/dispatch_options.py`); the entry point
+    0.6 us call with 14 arguments, `benchmarks/dispatch_options.py`); the entry point
     only unboxes them. The caller must pass exactly these types (a row's two
-    `Row.addresses`, a bool, then 11 floats): an array or None where a number belongs is a
-    TypeError, but no address is checked."""
+    `Row.addresses`, the address of a `step_params` array, a bool, then 8 floats): an array
+    or None where a number belongs is a TypeError, but no address is checked."""
     return _step_packed.compile(_STEP_SIGNATURE)
+
+
+def step_params(
+    max_substep: float, max_edge_cells: float, e_relaxed: float, v_c1: float, v_c2: float
+) -> np.ndarray:
+    """The constants `_step_packed` reads at its ``params`` address (``PARAM_*``): the caller
+    keeps the array alive while it passes its address (``array.ctypes.data``)."""
+    params = np.empty(PARAM_SIZE)
+    params[PARAM_MAX_SUBSTEP] = max_substep
+    params[PARAM_MAX_EDGE_CELLS] = max_edge_cells
+    params[PARAM_E_RELAXED] = e_relaxed
+    params[PARAM_V_C1] = v_c1
+    params[PARAM_V_C2] = v_c2
+    return params
 
 
 def regrid_buffer(n: int, k: int, m: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -4950,8 +4996,9 @@ def warm_up() -> None:
     # The simulator's step calls the kernel through its two buffers (`_step_packed`'s entry
     # point; `_advance_packed`, the same without the derived outputs, is the benchmarks').
     step = step_entry()
-    step(*row.addresses, True, 0.0, 0.0, 0.1, 0.01, 0.0, 1.0, math.nan, 0.0, 1.0, 1.0, 1.0)
-    step(*row.addresses, False, 0.0, 0.0, 0.1, 0.01, 0.0, 1.0, 0.0, 0.0, 1.0, 1.0, 1.0)
+    params = step_params(0.0, 1.0, 1.0, 1.0, 1.0)
+    step(*row.addresses, params.ctypes.data, True, 0.0, 0.0, 0.1, 0.01, math.nan, 0.0, -0.0, -0.0)
+    step(*row.addresses, params.ctypes.data, False, 0.0, 0.0, 0.1, 0.01, 0.0, 0.0, -0.0, -0.0)
     _restore_state(row.wl, row.wsum, row.wb, row.bsum, row.txn, row.txn_b)
     _g_at(0.3, row.gf, row.df)
     stored_energy(row, 0.3, 0.1)

@@ -436,6 +436,13 @@ class _TimeStepped:
         # without it). A longer step is refused before the kernel runs (`advance`, the lean
         # paths of `ContactSimulator.step` leave it to `advance`).
         self._longest_step = self._max_substep * MAX_SUBSTEPS if self._max_substep > 0.0 else math.inf
+        # The constants every kernel call reads (`_kernels.step_params`: those two and, for the
+        # derived outputs, E_r* and the critical edge speeds), passed as one address.
+        v_c1, v_c2 = (float(v) for v in physics.critical_speeds)
+        self._params = _kernels.step_params(
+            self._max_substep, self._max_edge_cells, float(physics.e_relaxed), v_c1, v_c2
+        )
+        self._params_address = self._params.ctypes.data
         # The compiled step (`_kernels._step_packed`) called through its entry point; loaded
         # (or compiled) with the first time-stepped model.
         global _STEP
@@ -519,6 +526,16 @@ class _TimeStepped:
         # The fine point where the glass modulus' JKR curve on the first domain has its
         # force minimum (`glass_contact`), found on first use.
         self._glass_lowest: int | None = None
+
+    def __getstate__(self) -> dict:
+        # A copy (pickle, deepcopy) has its own `_params`: its address is found again on load.
+        state = dict(self.__dict__)
+        del state["_params_address"]
+        return state
+
+    def __setstate__(self, state: dict) -> None:
+        self.__dict__.update(state)
+        self._params_address = self._params.ctypes.data
 
     # -- the domain ---------------------------------------------------------------------
     def _build_row(
@@ -844,25 +861,25 @@ class _TimeStepped:
             # The kernel itself, not the validating wrapper: the row's arrays are checked
             # when built, the step's scalars by ContactSimulator.step.
             # (`_step_packed`'s phase and speed outputs are not needed here: `_publish` makes them.)
+            # The step's own work (-0.0 + work) and the dissipated energy's new total.
             state, const = row.addresses
             result = _STEP(
                 state,
                 const,
+                self._params_address,
                 journal,
                 self.radius,
                 d0,
                 d1,
                 dt,
-                self._max_substep,
-                self._max_edge_cells,
                 force_prev,
                 self.radius,
-                0.0,
-                0.0,
-                0.0,
+                -0.0,
+                dissipated0,
             )
             journal = False
-            if result[0] == _kernels.STATUS_OK:
+            if result[0] != _kernels.STATUS_GROW:
+                # (STATUS_OVERFLOW too: the caller refuses a step whose energies overflow.)
                 break
             force_prev = math.nan  # a new row after the growth
             if start is None:
@@ -872,7 +889,7 @@ class _TimeStepped:
             self.radius, self.dissipated = radius0, dissipated0
             self._grow(d0)
             start = self.get_state()
-        self._stepped(row, result, d1, dissipated0)
+        self._stepped(row, result, d1)
         return result[1], result[2], result[3]
 
     def let_go_depth(self) -> float:
@@ -890,13 +907,14 @@ class _TimeStepped:
             return known[3]
         return math.nan
 
-    def _stepped(self, row: _kernels.Row, result: tuple, d1: float, dissipated0: float) -> None:
+    def _stepped(self, row: _kernels.Row, result: tuple, d1: float) -> None:
         """The model's fields after a kernel call on `row` that stepped to depth `d1` (m):
-        `result` is `_STEP`'s tuple, `dissipated0` the energy dissipated before the call (J)."""
+        `result` is `_STEP`'s tuple (given the energy dissipated before the call: its new
+        total)."""
         radius = result[1]
         self.radius = radius
         self.substeps = result[4]
-        self.dissipated = dissipated0 + result[5]
+        self.dissipated = result[5]
         self._memory_peak = result[6]
         self._edge = result[7]
         self._edge_depth = d1
@@ -1159,10 +1177,6 @@ class _TimeStepped:
         self._journal = None
         self._edge_depth = math.nan
         self._force_at = None
-
-
-#: The code of `_TimeStepped.advance`, which `ContactSimulator.step`'s one-call path inlines.
-_ADVANCE_CODE = _TimeStepped.advance.__code__
 
 
 def _phase(model: Any, physics: _Physics, depth: float, r0: float, radius: float, g_edge: float) -> Phase:
@@ -1477,9 +1491,6 @@ class ContactSimulator:
         else:
             first = _first_domain(self.physics, self.numerics)
         self._depth_limit = _largest_domain(first)
-        # The physics constants the compiled step derives its outputs from (`_STEP`).
-        self._e_relaxed = float(self.physics.e_relaxed)
-        self._v_c1, self._v_c2 = (float(v) for v in self.physics.critical_speeds)
         self.reset(0.0)
 
     # -- public state ---------------------------------------------------------------------
@@ -1621,72 +1632,93 @@ class ContactSimulator:
         # this one frame, the edge outputs read from the kernel's (`edge_height` and
         # `edge_gaps` return the same values after an advance): the general path's outputs and
         # state bit for bit, and its transaction (tests/test_step_lean.py).
-        if isinstance(time, float) and time == self._time and self._repeats(depth, force):
-            # The command the last step took, again at its instant (a message logged twice, a
-            # controller republishing): the step as it is. A second force search from the
-            # solved state could land elsewhere within the force tolerance (~1e-10 m), and a
-            # zero-time depth step searched the edge again (outside tester, 0.10.0; the
-            # kernel's `_advance_from` keeps the state for the batch path too).
-            return self._output
-        if force is None and self._lean:
-            if type(depth) is float and type(time) is float:
-                t, d = time, depth
-            elif isinstance(depth, float) and isinstance(time, float):
+        if force is None and type(depth) is float and type(time) is float:
+            # The common call (float time and depth) tested first: the repeat check below with
+            # these types, then the lean path (0.12.0 `percall`: ~30 ns less than the general
+            # order of tests).
+            t = time
+            d = depth
+            time0 = self._time
+            if t == time0 and self._repeats(d, None):
+                return self._output
+            lean = self._lean
+        else:
+            if isinstance(time, float) and time == self._time and self._repeats(depth, force):
+                # The command the last step took, again at its instant (a message logged
+                # twice, a controller republishing): the step as it is. A second force search
+                # from the solved state could land elsewhere within the force tolerance
+                # (~1e-10 m), and a zero-time depth step searched the edge again (outside
+                # tester, 0.10.0; the kernel's `_advance_from` keeps the state for the batch
+                # path too).
+                return self._output
+            lean = False
+            if force is None and self._lean:
+                if not (isinstance(depth, float) and isinstance(time, float)):
+                    return self._step_transaction(time, depth, force)
                 t, d = float(time), float(depth)
-            else:
-                return self._step_transaction(time, depth, force)
+                time0 = self._time
+                lean = True
+        if lean:
             model = self._model
             d_prev = self._depth
             output0 = self._output
             r0 = output0.contact_radius
-            time0 = self._time
+            dt = t - time0
+            limit = self._depth_limit
+            # (`-limit <= d <= limit` is `abs(d) <= limit` for every float, NaN included.)
             if (
                 t - t == 0.0
-                and abs(d) <= self._depth_limit
-                and (t == time0 or MIN_TIME_STEP <= t - time0 <= model._longest_step)
+                and -limit <= d <= limit
+                and (t == time0 or MIN_TIME_STEP <= dt <= model._longest_step)
                 and not (d < 0.0 and d_prev < 0.0 and r0 <= 0.0 and model.is_relaxed())
             ):
                 row = model.row
-                if row is not None and getattr(model.advance, "__code__", None) is _ADVANCE_CODE:
+                if row is not None and "advance" not in model.__dict__:
                     # The row exists (the common case): `begin`, `advance`, `_phase` and the
                     # derived outputs in one compiled call (`_STEP`, journal included), the
                     # transaction's token kept in locals. A step that needs a larger domain
                     # goes back to the journal and takes the path below (it grows the row),
                     # as does a model whose `advance` was replaced on the instance (the fault
-                    # tests inject errors after the kernel that way; reading the instance's
-                    # `__dict__` instead cost ~0.4 us a step: it deoptimises the model's
-                    # attribute access).
+                    # tests inject errors after the kernel that way), found in the instance's
+                    # dict: ~70 ns a step less than making the bound method to compare its
+                    # function (0.12.0 `percall`). The model's dict is a real one already
+                    # (it has more attributes than CPython 3.11/3.12 keep inline, 30), so
+                    # reading it deoptimises nothing; on a model with inline attributes it
+                    # would (0.5.0 measured ~0.4 us a step then).
                     radius0 = model.radius
                     dissipated0 = model.dissipated
                     peak0 = model._memory_peak
                     edge0 = model._edge
                     edge_depth0 = model._edge_depth
                     known = model._force_at
-                    # `_TimeStepped.advance`'s rule for the force known at the start.
-                    if (
-                        known is not None
-                        and known[0] is row
-                        and known[1] == radius0
-                        and known[2] == d_prev
-                        and d_prev != 0.0
-                    ):
-                        force_prev = known[3]
-                    else:
+                    # `_TimeStepped.advance`'s rule for the force known at the start (the
+                    # tuple unpacked: four subscripts cost more).
+                    if known is None:
                         force_prev = math.nan
-                    dt = t - time0
+                    else:
+                        known_row, known_radius, known_depth, force_prev = known
+                        if not (
+                            known_row is row
+                            and known_radius == radius0
+                            and known_depth == d_prev
+                            and d_prev != 0.0
+                        ):
+                            force_prev = math.nan
                     state, const = row.addresses
                     energy0 = self._energy_input
                     held0 = self._held_force
                     model._journal = None
                     try:
                         model._journal = row
+                        # The energy input and dissipated energy after the step come back
+                        # summed (energy0 + work, dissipated0 + the step's losses) and checked.
                         (
                             status,
                             radius,
                             f,
-                            work,
+                            energy,
                             substeps,
-                            step_dissipated,
+                            dissipated,
                             peak,
                             edge,
                             phase,
@@ -1696,24 +1728,18 @@ class ContactSimulator:
                         ) = _STEP(
                             state,
                             const,
+                            model._params_address,
                             True,
                             radius0,
                             d_prev,
                             d,
                             dt,
-                            model._max_substep,
-                            model._max_edge_cells,
                             force_prev,
                             r0,
-                            self._e_relaxed,
-                            self._v_c1,
-                            self._v_c2,
+                            energy0,
+                            dissipated0,
                         )
                         if status == 0:  # _kernels.STATUS_OK
-                            energy = energy0 + work
-                            dissipated = dissipated0 + step_dissipated
-                            if not (energy - energy == 0.0 and dissipated - dissipated == 0.0):
-                                raise _overflow(energy, dissipated)
                             # The output first (nothing changed yet if it fails), then the
                             # commit. Filling the instance's dict item by item is cheaper than
                             # a dict display (`_new_output`).
@@ -1749,6 +1775,8 @@ class ContactSimulator:
                             self._output = output
                             self._held_force = None
                             return output
+                        if status == _kernels.STATUS_OVERFLOW:
+                            raise _overflow(energy, dissipated)
                         _kernels._restore_state(row.wl, row.wsum, row.wb, row.bsum, row.txn, row.txn_b)
                         model._journal = None
                     except BaseException:
@@ -1766,7 +1794,6 @@ class ContactSimulator:
                 held0 = self._held_force
                 token = model.begin()
                 try:
-                    dt = t - time0
                     radius, f, work = model.advance(d_prev, d, dt)
                     energy = energy0 + work
                     if not (energy - energy == 0.0 and model.dissipated - model.dissipated == 0.0):
@@ -1854,7 +1881,7 @@ class ContactSimulator:
         if not (
             slope >= FOLD_SLOPE * glass
             and row is not None
-            and getattr(model.advance, "__code__", None) is _ADVANCE_CODE
+            and "advance" not in model.__dict__  # (as the lean depth path)
             and t - self._time <= model._longest_step
         ):
             return None
@@ -1869,8 +1896,7 @@ class ContactSimulator:
             first = d0 + (target - f0 - memo[2] * dt) / slope
         bend = memo[3]
         state, const = row.addresses
-        max_substep, max_edge_cells = model._max_substep, model._max_edge_cells
-        e_relaxed, v_c1, v_c2 = self._e_relaxed, self._v_c1, self._v_c2
+        params = model._params_address
         token = model.begin()
         start = model.trial_start()
         radius0, dissipated0 = model.radius, model.dissipated
@@ -1905,28 +1931,28 @@ class ContactSimulator:
                         break
                 model._force_at = None
                 model._journal = row
+                # (The trial's own work, -0.0 + work; the dissipated energy's new total.)
                 result = _STEP(
                     state,
                     const,
+                    params,
                     True,
                     radius0,
                     d0,
                     x_new,
                     dt,
-                    max_substep,
-                    max_edge_cells,
                     force_prev,
                     r_before,
-                    e_relaxed,
-                    v_c1,
-                    v_c2,
+                    -0.0,
+                    dissipated0,
                 )
                 force_prev = math.nan
-                if result[0] != 0:  # not _kernels.STATUS_OK: the domain must grow
+                if result[0] == _kernels.STATUS_GROW:  # the domain must grow
+                    # (STATUS_OVERFLOW is a step: `_publish` below refuses it as before.)
                     result = None
                     grow = True
                     break
-                model._stepped(row, result, x_new, dissipated0)
+                model._stepped(row, result, x_new)
                 radius, f = result[1], result[2]
                 trials.append((x_new, f, radius))
                 last = [x_new, (radius, f, result[3])]
