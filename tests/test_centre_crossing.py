@@ -202,16 +202,19 @@ def test_finger_force_no_less_accurate_than_without_the_blend(name: str) -> None
     assert rms_err <= rms, f"{name}: RMS {rms_err:.3e} of the pull-off force off 8192 elements"
 
 
-def test_every_path_reads_the_blended_force() -> None:
+@pytest.mark.parametrize("body", ["standard", "slow_tail"])
+def test_every_path_reads_the_blended_force(body: str) -> None:
     """The slow press at `fast` and the sweep's depths as further rows (1 ms apart), through
     every path: `step_depths` (the batch kernel, `_advance_rows`) gives `step`'s bits, and
     force control, commanded each pressing row's depth-control force from that row's start,
     returns to the row's depth within 1e-4 d_c (measured 3.9e-5; 0.11.0, whose force jumped at
-    each centre, 7.9e-3 d_c: a force inside a jump has no depth)."""
+    each centre, 7.9e-3 d_c: a force inside a jump has no depth). The same with the slow-tail
+    second Kelvin element (`SECOND_ELEMENT`), whose per-mode share the paths read alike."""
+    kelvin, viscosities = SECOND_ELEMENT.get(body, ([G1], [TAU * (G0 + G1)]))
     contact = one_contact(
         {"shape": "sphere", "radius": RADIUS},
-        kelvin=[G1],
-        viscosities=[TAU * (G0 + G1)],
+        kelvin=kelvin,
+        viscosities=viscosities,
         work=WORK,
         numerics={"preset": "fast", "model": "time_stepped"},
     )
