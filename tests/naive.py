@@ -182,7 +182,14 @@ def force(row: _kernels.Row, radius: float, depth: float, points: int = 200001) 
         shares = np.where(
             rel >= 1.0 - _kernels.MODE_RELAXED,
             1.0,
-            np.where(rel <= 0.0, 0.0, np.maximum(0.0, 1.0 + _kernels.CENTRE_CUT / np.log1p(-np.clip(rel, 1e-300, 1.0 - _kernels.MODE_RELAXED)))),
+            np.where(
+                rel <= 0.0,
+                0.0,
+                np.maximum(
+                    0.0,
+                    1.0 + _kernels.CENTRE_CUT / np.log1p(-np.clip(rel, 1e-300, 1.0 - _kernels.MODE_RELAXED)),
+                ),
+            ),
         )
         c = float(weights @ shares / weights.sum()) if weights.sum() > 0.0 else 0.0
     return integral(n_in - 1) + c * (1.0 - s) * (integral(n_in - 2) - integral(n_in - 1))

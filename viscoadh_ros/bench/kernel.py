@@ -108,7 +108,9 @@ def _force_parts(radius, depth, wsum, bsum, dx, g_c, gf, gint, df, e0, kap, buf,
     """The contact force (its memory integral) once per row at the row's edge."""
     total = 0.0
     for s in range(1, depth.shape[0]):  # pragma: no cover - compiled
-        total += _kernels._force(radius, depth[s], wsum, bsum, dx, g_c, gf, gint, df, e0, kap, buf, wb, p, p_inv, lam, beta)
+        total += _kernels._force(
+            radius, depth[s], wsum, bsum, dx, g_c, gf, gint, df, e0, kap, buf, wb, p, p_inv, lam, beta
+        )
     return total
 
 

@@ -1026,7 +1026,9 @@ def _force(a, d, wsum, bsum, dx, g_c, gf, gint, df, e0, kap, buf, wb, p, p_inv, 
     u_int = d * a - _profile_integral(a, gf, gint, df)
     if kap == 0.0:
         return 2.0 * e0 * u_int  # no Kelvin element: no memory
-    dev = _deviation_integral(a, d, wsum, bsum, n_in, dx, g_c, gf, gint, df, kap, buf, wb, p, p_inv, lam, beta)
+    dev = _deviation_integral(
+        a, d, wsum, bsum, n_in, dx, g_c, gf, gint, df, kap, buf, wb, p, p_inv, lam, beta
+    )
     return 2.0 * e0 * ((1.0 - kap) * u_int - dev)
 
 
@@ -3192,7 +3194,9 @@ def _advance_body(row, a, d0, d1, dt, max_substep, max_edge_move, force_prev, ba
                 gf,
                 df,
             )
-        force_new = _force(new_a, d1, wsum, bsum, dx, g_c, gf, gint, df, e0, kap, diss, wb, p, p_inv, lam, beta)
+        force_new = _force(
+            new_a, d1, wsum, bsum, dx, g_c, gf, gint, df, e0, kap, diss, wb, p, p_inv, lam, beta
+        )
         out[OUT_RADIUS] = new_a
         out[OUT_FORCE] = force_new
         out[OUT_WORK] = 0.5 * (force_prev + force_new) * (d1 - d0)
@@ -3549,11 +3553,15 @@ def _advance_body(row, a, d0, d1, dt, max_substep, max_edge_move, force_prev, ba
                 block = t_lo
             _defer_coefficients(lam, rate, tau + h - t0, coef)
             dev = _block_deviation(block, d_org, db, kap, dx, p, p_inv, beta, coef, sum_g, sum_cb, sum_r)
-            dev += _deviation_after(new_a, db, wsum, bsum, n_new, block, dx, g_c, gf, gint, df, kap, wb, p, p_inv, lam, beta)
+            dev += _deviation_after(
+                new_a, db, wsum, bsum, n_new, block, dx, g_c, gf, gint, df, kap, wb, p, p_inv, lam, beta
+            )
             u_int = db * new_a - _profile_integral(new_a, gf, gint, df)
             force_new = 2.0 * e0 * ((1.0 - kap) * u_int - dev)
         else:
-            force_new = _force(new_a, db, wsum, bsum, dx, g_c, gf, gint, df, e0, kap, diss, wb, p, p_inv, lam, beta)
+            force_new = _force(
+                new_a, db, wsum, bsum, dx, g_c, gf, gint, df, e0, kap, diss, wb, p, p_inv, lam, beta
+            )
         work += 0.5 * (force_prev + force_new) * (db - da)
         force_prev = force_new
         if sub_motion != MOTION_NONE:
