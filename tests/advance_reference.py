@@ -55,7 +55,10 @@ def advance_reference(
     # gmax, df, e0, c_crit, reach, p, p_inv, lam, beta, rate, kap, e_kelvin, out
     wl, wsum, wb, bsum = args[0:4]
     dx, g_c, gf, gint, df, e0, kap = args[8], args[9], args[10], args[11], args[14], args[15], args[23]
-    force_prev = _force(radius, d0, wsum, bsum, dx, g_c, gf, gint, df, e0, kap, wsum[:0])
+    p, p_inv, lam, beta = args[18], args[19], args[20], args[21]
+    force_prev = _force(
+        radius, d0, wsum, bsum, dx, g_c, gf, gint, df, e0, kap, wsum[:0], wb, p, p_inv, lam, beta
+    )
     status = advance_from_reference(
         *args,
         float(radius),
@@ -173,7 +176,9 @@ def advance_from_reference(
             gf,
             df,
         )
-        force_new = _force(new_a, d1, wsum, bsum, dx, g_c, gf, gint, df, e0, kap, wsum[:0])
+        force_new = _force(
+            new_a, d1, wsum, bsum, dx, g_c, gf, gint, df, e0, kap, wsum[:0], wb, p, p_inv, lam, beta
+        )
         out[OUT_RADIUS] = new_a
         out[OUT_FORCE] = force_new
         out[OUT_WORK] = 0.5 * (force_prev + force_new) * (d1 - d0)
@@ -340,7 +345,9 @@ def advance_from_reference(
                 peak,
             )
         lost += viscous + _adhesion_loss(hysteresis, a, new_a, max_edge_move)
-        force_new = _force(new_a, db, wsum, bsum, dx, g_c, gf, gint, df, e0, kap, wsum[:0])
+        force_new = _force(
+            new_a, db, wsum, bsum, dx, g_c, gf, gint, df, e0, kap, wsum[:0], wb, p, p_inv, lam, beta
+        )
         work += 0.5 * (force_prev + force_new) * (db - da)
         force_prev = force_new
         if sub_motion != MOTION_NONE:

@@ -174,6 +174,24 @@ def force(row: _kernels.Row, radius: float, depth: float, points: int = 200001) 
     # The blend's share: 1 - CENTRE_CUT v tau / dx, v tau / dx = -1 / ln(1 - B_{L-1} / kap).
     r = row.bsum[n_in - 2] / row.kap if row.kap > 0.0 else 1.0
     c = 1.0 if r >= 1.0 else 0.0 if r <= 0.0 else max(0.0, 1.0 + _kernels.CENTRE_CUT / np.log1p(-r))
+    if c < 1.0 and row.wb.shape[1] > 1:
+        # K >= 2: per relaxation mode, weighted by the mode's part of B_{L-1} (`_modal_share`).
+        zb = row.p @ row.wb[n_in - 2]
+        weights = np.abs(row.p_inv.sum(axis=0) * zb)
+        rel = zb / (row.beta / row.lam)
+        shares = np.where(
+            rel >= 1.0 - _kernels.MODE_RELAXED,
+            1.0,
+            np.where(
+                rel <= 0.0,
+                0.0,
+                np.maximum(
+                    0.0,
+                    1.0 + _kernels.CENTRE_CUT / np.log1p(-np.clip(rel, 1e-300, 1.0 - _kernels.MODE_RELAXED)),
+                ),
+            ),
+        )
+        c = float(weights @ shares / weights.sum()) if weights.sum() > 0.0 else 0.0
     return integral(n_in - 1) + c * (1.0 - s) * (integral(n_in - 2) - integral(n_in - 1))
 
 

@@ -136,12 +136,44 @@ def test_the_timed_parts_do_the_kernels_work(kelvin: int) -> None:
     buf = np.empty(row.elements)
     force = sum(
         _kernels._force(
-            radius, d, row.wsum, row.bsum, row.dx, row.g_c, row.gf, row.gint, row.df, row.e0, row.kap, buf
+            radius,
+            d,
+            row.wsum,
+            row.bsum,
+            row.dx,
+            row.g_c,
+            row.gf,
+            row.gint,
+            row.df,
+            row.e0,
+            row.kap,
+            buf,
+            row.wb,
+            row.p,
+            row.p_inv,
+            row.lam,
+            row.beta,
         )
         for d in depth[1:]
     )
     assert kernel._force_parts(
-        radius, depth, row.wsum, row.bsum, row.dx, row.g_c, row.gf, row.gint, row.df, row.e0, row.kap, buf
+        radius,
+        depth,
+        row.wsum,
+        row.bsum,
+        row.dx,
+        row.g_c,
+        row.gf,
+        row.gint,
+        row.df,
+        row.e0,
+        row.kap,
+        buf,
+        row.wb,
+        row.p,
+        row.p_inv,
+        row.lam,
+        row.beta,
     ) == pytest.approx(force, rel=1e-14)
     edges = sum(
         _kernels._locate_edge(

@@ -104,11 +104,13 @@ def _update_parts(wl, wsum, wb, bsum, diss, n_in, depth, dt, g_c, p, p_inv, lam,
 
 
 @numba.njit
-def _force_parts(radius, depth, wsum, bsum, dx, g_c, gf, gint, df, e0, kap, buf):
+def _force_parts(radius, depth, wsum, bsum, dx, g_c, gf, gint, df, e0, kap, buf, wb, p, p_inv, lam, beta):
     """The contact force (its memory integral) once per row at the row's edge."""
     total = 0.0
     for s in range(1, depth.shape[0]):  # pragma: no cover - compiled
-        total += _kernels._force(radius, depth[s], wsum, bsum, dx, g_c, gf, gint, df, e0, kap, buf)
+        total += _kernels._force(
+            radius, depth[s], wsum, bsum, dx, g_c, gf, gint, df, e0, kap, buf, wb, p, p_inv, lam, beta
+        )
     return total
 
 
@@ -159,6 +161,11 @@ def _part_runs(
             row.e0,
             row.kap,
             buf,
+            row.wb,
+            row.p,
+            row.p_inv,
+            row.lam,
+            row.beta,
         )
 
     def run_edge() -> None:

@@ -823,7 +823,7 @@ def _simpson_tail(x0, f0, a, d, wsum, bsum, last, dx, g_c, gf, df, kap):
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
-def _edge_piece(a, d, wsum, bsum, n_in, dx, g_c, gf, df, kap):
+def _edge_piece(a, d, wsum, bsum, n_in, dx, g_c, gf, df, kap, wb, p, p_inv, lam, beta):
     """The deviation integral's part past the last interior centre ``x_L`` (element
     L = n_in - 1): Simpson's piece up to the edge (A and B extrapolated, `_side_ab`), blended
     with weight ``1 - s`` towards the same span read without element L (A and B extrapolated
@@ -863,7 +863,10 @@ def _edge_piece(a, d, wsum, bsum, n_in, dx, g_c, gf, df, kap):
     f_mid = (a_mid - kap * d) - _g_between(last, gf, df, dx, wsum.shape[0]) * (b_mid - kap)
     cell = dx * (f_prev + 4.0 * f_mid + f_last) / 6.0
     without = _simpson_tail(x_last - dx, f_prev, a, d, wsum, bsum, prev, dx, g_c, gf, df, kap)
-    return piece + (1.0 - s) * _relaxed_share(bsum[prev], kap) * (without - cell - piece)
+    share = _relaxed_share(bsum[prev], kap)
+    if share < 1.0 and wb.shape[1] > 1:
+        share = _modal_share(wb, prev, p, p_inv, lam, beta)
+    return piece + (1.0 - s) * share * (without - cell - piece)
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
@@ -895,8 +898,53 @@ def _relaxed_share(b_prev, b_relaxed):
     return max(0.0, 1.0 + CENTRE_CUT / math.log1p(-r))
 
 
+#: `_modal_share`: a mode whose unit memory is within this fraction of its relaxed level counts
+#: as relaxed (the modal transform's rounding: a relaxed mode of a K = 2 chain read 1 - 1.1e-14).
+MODE_RELAXED = 1e-12
+
+
 @numba.njit(cache=True, nogil=True, _nrt=False)
-def _deviation_integral(a, d, wsum, bsum, n_in, dx, g_c, gf, gint, df, kap, buf):
+def _modal_share(wb, prev, p, p_inv, lam, beta):
+    """`_relaxed_share` for a chain of K >= 2 Kelvin elements, per relaxation mode: mode m's
+    unit memory ``zb_m = sum_k p[m, k] wb[prev, k]`` relaxes towards ``beta_m / lam_m`` with
+    its own time, and its share (``max(0, 1 - CENTRE_CUT lam_m^-1 v / dx)`` read from its
+    ``r_m``, as `_relaxed_share`; 1 within MODE_RELAXED of relaxed) is weighted by how much of
+    element L-1's total unit memory it carries, ``|sum_k p_inv[k, m] zb_m|``: what a glassy
+    element L reads against. A mode far slower than the press carries almost nothing at L-1
+    (it has not left glassy anywhere near the edge) and no longer switches the blend off,
+    which the total ``B_{L-1} / kap`` did (an outside tester, 0.12.0: a standard solid plus a
+    1e4 s element, jump 5.7e-2 of the pull-off force at `fast`)."""
+    k_count = wb.shape[1]
+    num = 0.0
+    den = 0.0
+    for m in range(k_count):
+        zb = 0.0
+        for k in range(k_count):
+            zb += p[m, k] * wb[prev, k]
+        col = 0.0
+        for k in range(k_count):
+            col += p_inv[k, m]
+        weight = abs(col * zb)
+        relaxed = beta[m] / lam[m]
+        if relaxed == 0.0:
+            share = 1.0
+        else:
+            r = zb / relaxed
+            if r >= 1.0 - MODE_RELAXED:
+                share = 1.0
+            elif r <= 0.0:
+                share = 0.0
+            else:
+                share = max(0.0, 1.0 + CENTRE_CUT / math.log1p(-r))
+        num += weight * share
+        den += weight
+    if den <= 0.0:
+        return 0.0
+    return num / den
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False)
+def _deviation_integral(a, d, wsum, bsum, n_in, dx, g_c, gf, gint, df, kap, buf, wb, p, p_inv, lam, beta):
     """Integral over (0, a) of the interior memory's deviation from relaxed,
     ``dev = w - kap u = (A - kap d) - g (B - kap)``, m^2.
 
@@ -930,7 +978,7 @@ def _deviation_integral(a, d, wsum, bsum, n_in, dx, g_c, gf, gint, df, kap, buf)
         sum_f, sum_b = _weighted_sums(0, n_in, wsum, bsum, g_c, cb, kap, kap * d)
         last = n_in - 1
         total = dx * sum_f - 0.5 * dx * (wsum[last] - kap * d) + (sum_b - q_last * bsum[last]) + kap * e_last
-        return total + _edge_piece(a, d, wsum, bsum, n_in, dx, g_c, gf, df, kap)
+        return total + _edge_piece(a, d, wsum, bsum, n_in, dx, g_c, gf, df, kap, wb, p, p_inv, lam, beta)
     per_cell = (m - 1) // wsum.shape[0]
     on_grid = per_cell * wsum.shape[0] == m - 1
     if buf.shape[0] >= n_in:
@@ -962,11 +1010,11 @@ def _deviation_integral(a, d, wsum, bsum, n_in, dx, g_c, gf, gint, df, kap, buf)
             f_mid = (a_mid - kap * d) - g_mid * (b_mid - kap)
             total += dx * (f_prev + 4.0 * f_mid + f_i) / 6.0
             f_prev = f_i
-    return total + _edge_piece(a, d, wsum, bsum, n_in, dx, g_c, gf, df, kap)
+    return total + _edge_piece(a, d, wsum, bsum, n_in, dx, g_c, gf, df, kap, wb, p, p_inv, lam, beta)
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
-def _force(a, d, wsum, bsum, dx, g_c, gf, gint, df, e0, kap, buf):
+def _force(a, d, wsum, bsum, dx, g_c, gf, gint, df, e0, kap, buf, wb, p, p_inv, lam, beta):
     """Normal force ``F = 2 E0* int_0^a (u - w) dx = 2 E0* ((1-kap) int u - int dev)``, N,
     with ``dev = w - kap u`` the memory's deviation from relaxed (zero when relaxed, so
     the relaxed force carries no interpolation error amplified by E0*/E_r*). ``buf``: as
@@ -978,7 +1026,9 @@ def _force(a, d, wsum, bsum, dx, g_c, gf, gint, df, e0, kap, buf):
     u_int = d * a - _profile_integral(a, gf, gint, df)
     if kap == 0.0:
         return 2.0 * e0 * u_int  # no Kelvin element: no memory
-    dev = _deviation_integral(a, d, wsum, bsum, n_in, dx, g_c, gf, gint, df, kap, buf)
+    dev = _deviation_integral(
+        a, d, wsum, bsum, n_in, dx, g_c, gf, gint, df, kap, buf, wb, p, p_inv, lam, beta
+    )
     return 2.0 * e0 * ((1.0 - kap) * u_int - dev)
 
 
@@ -2751,7 +2801,7 @@ def _block_deviation(block, d0, d, kap, dx, p, p_inv, beta, coef, sum_g, sum_cb,
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
-def _deviation_after(a, d, wsum, bsum, n_in, block, dx, g_c, gf, gint, df, kap):
+def _deviation_after(a, d, wsum, bsum, n_in, block, dx, g_c, gf, gint, df, kap, wb, p, p_inv, lam, beta):
     """`_deviation_integral` less the deferred block's part (`_block_change`, elements
     0..block-1, 1 <= block <= n_in - 4): element ``block``'s share of the Simpson piece
     before it, the pieces after it and the extrapolated piece up to the edge."""
@@ -2766,7 +2816,7 @@ def _deviation_after(a, d, wsum, bsum, n_in, block, dx, g_c, gf, gint, df, kap):
         last = n_in - 1
         total = dx * sum_f - 0.5 * dx * wsum[last] + (sum_b - q_last * bsum[last])
         total += kap * (gint[eo + n_in] - gint[eo + block])
-        return total + _edge_piece(a, d, wsum, bsum, n_in, dx, g_c, gf, df, kap)
+        return total + _edge_piece(a, d, wsum, bsum, n_in, dx, g_c, gf, df, kap, wb, p, p_inv, lam, beta)
     gm = _g_between(block, gf, df, dx, n)
     g_prev = g_c[block - 1]
     g_b = g_c[block]
@@ -2784,7 +2834,7 @@ def _deviation_after(a, d, wsum, bsum, n_in, block, dx, g_c, gf, gint, df, kap):
         f_mid = (a_mid - kap * d) - g_mid * (b_mid - kap)
         total += dx * (f_prev + 4.0 * f_mid + f_i) / 6.0
         f_prev = f_i
-    return total + _edge_piece(a, d, wsum, bsum, n_in, dx, g_c, gf, df, kap)
+    return total + _edge_piece(a, d, wsum, bsum, n_in, dx, g_c, gf, df, kap, wb, p, p_inv, lam, beta)
 
 
 @numba.njit(cache=True, nogil=True, _nrt=False)
@@ -2877,7 +2927,7 @@ def _advance(
     STATUS_GROW (state partly advanced: the caller restores) when the contact needs a larger
     domain.
     """
-    force_prev = _force(a, d0, wsum, bsum, dx, g_c, gf, gint, df, e0, kap, diss)
+    force_prev = _force(a, d0, wsum, bsum, dx, g_c, gf, gint, df, e0, kap, diss, wb, p, p_inv, lam, beta)
     return _advance_from(
         wl,
         wsum,
@@ -3093,7 +3143,7 @@ def _advance_body(row, a, d0, d1, dt, max_substep, max_edge_move, force_prev, ba
         # at rest commanded to its own depth (0 after a reset) snaps in there
         # (docs/ros_interface.md).
         force_same = force_prev if force_prev == force_prev else _force(
-            a, d1, wsum, bsum, dx, g_c, gf, gint, df, e0, kap, diss
+            a, d1, wsum, bsum, dx, g_c, gf, gint, df, e0, kap, diss, wb, p, p_inv, lam, beta
         )
         out[OUT_RADIUS] = a
         out[OUT_FORCE] = force_same
@@ -3144,7 +3194,9 @@ def _advance_body(row, a, d0, d1, dt, max_substep, max_edge_move, force_prev, ba
                 gf,
                 df,
             )
-        force_new = _force(new_a, d1, wsum, bsum, dx, g_c, gf, gint, df, e0, kap, diss)
+        force_new = _force(
+            new_a, d1, wsum, bsum, dx, g_c, gf, gint, df, e0, kap, diss, wb, p, p_inv, lam, beta
+        )
         out[OUT_RADIUS] = new_a
         out[OUT_FORCE] = force_new
         out[OUT_WORK] = 0.5 * (force_prev + force_new) * (d1 - d0)
@@ -3501,11 +3553,15 @@ def _advance_body(row, a, d0, d1, dt, max_substep, max_edge_move, force_prev, ba
                 block = t_lo
             _defer_coefficients(lam, rate, tau + h - t0, coef)
             dev = _block_deviation(block, d_org, db, kap, dx, p, p_inv, beta, coef, sum_g, sum_cb, sum_r)
-            dev += _deviation_after(new_a, db, wsum, bsum, n_new, block, dx, g_c, gf, gint, df, kap)
+            dev += _deviation_after(
+                new_a, db, wsum, bsum, n_new, block, dx, g_c, gf, gint, df, kap, wb, p, p_inv, lam, beta
+            )
             u_int = db * new_a - _profile_integral(new_a, gf, gint, df)
             force_new = 2.0 * e0 * ((1.0 - kap) * u_int - dev)
         else:
-            force_new = _force(new_a, db, wsum, bsum, dx, g_c, gf, gint, df, e0, kap, diss)
+            force_new = _force(
+                new_a, db, wsum, bsum, dx, g_c, gf, gint, df, e0, kap, diss, wb, p, p_inv, lam, beta
+            )
         work += 0.5 * (force_prev + force_new) * (db - da)
         force_prev = force_new
         if sub_motion != MOTION_NONE:
@@ -3674,7 +3730,7 @@ def _advance_rows(
     A row starts from the force the row before ended with (the same memory, radius and
     depth: `_force` would return the same number).
     """
-    force_prev = _force(a, d_prev, wsum, bsum, dx, g_c, gf, gint, df, e0, kap, diss)
+    force_prev = _force(a, d_prev, wsum, bsum, dx, g_c, gf, gint, df, e0, kap, diss, wb, p, p_inv, lam, beta)
     for i in range(first, times.shape[0]):
         d1 = depths[i]
         if a <= 0.0 and peak <= idle_limit and d1 < 0.0 and d_prev < 0.0:
@@ -4845,6 +4901,11 @@ def force(row: Row, radius: float, depth: float) -> float:
             row.e0,
             row.kap,
             _NO_BUFFER,
+            row.wb,
+            row.p,
+            row.p_inv,
+            row.lam,
+            row.beta,
         )
     )
 
