@@ -12,6 +12,12 @@ import pytest
 from viscoadh_ros.core import _kernels
 
 
+def _one_mode(bsum: np.ndarray) -> tuple:
+    """The per-mode arguments of `_force`/`_deviation_integral` for one Kelvin element (the
+    centre blend's share is then read from the total unit memory alone): wb, p, p_inv, lam, beta."""
+    one = np.ones(1)
+    return bsum.reshape(-1, 1), np.eye(1), np.eye(1), one, one
+
 def _grid(n: int, per_cell: int, on_grid: bool, rng: np.random.Generator):
     length = 1e-4
     dx = length / n
@@ -41,11 +47,11 @@ def test_the_buffered_sum_is_the_one_loop_bit_for_bit(n: int, per_cell: int, on_
             n_in = _kernels._interior_count(a, dx, n)
             buf = np.full(n, np.nan)
             args = (a, d, wsum, bsum, n_in, dx, g_c, gf, gint, df, kap)
-            one = _kernels._deviation_integral(*args, np.empty(0))
-            two = _kernels._deviation_integral(*args, buf)
+            one = _kernels._deviation_integral(*args, np.empty(0), *_one_mode(bsum))
+            two = _kernels._deviation_integral(*args, buf, *_one_mode(bsum))
             assert np.float64(one).tobytes() == np.float64(two).tobytes(), (trial, a, one, two)
             force = (
-                _kernels._force(a, d, wsum, bsum, dx, g_c, gf, gint, df, 1e6, kap, b)
+                _kernels._force(a, d, wsum, bsum, dx, g_c, gf, gint, df, 1e6, kap, b, *_one_mode(bsum))
                 for b in (np.empty(0), buf)
             )
             assert len({np.float64(f).tobytes() for f in force}) == 1
@@ -80,10 +86,10 @@ def test_the_sum_form_is_simpsons_integral_to_rounding(n: int, per_cell: int, on
         for a in (rng.uniform(0.0, length), (rng.integers(1, n) + 0.5) * dx, length, 0.3 * dx, 1.2 * dx):
             n_in = _kernels._interior_count(a, dx, n)
             simpson = _kernels._deviation_integral(
-                a, d, wsum, bsum, n_in, dx, g_c, gf, gint, df, kap, np.empty(0)
+                a, d, wsum, bsum, n_in, dx, g_c, gf, gint, df, kap, np.empty(0), *_one_mode(bsum)
             )
             summed = _kernels._deviation_integral(
-                a, d, wsum, bsum, n_in, dx, g_c, gf, gint_w, df, kap, np.empty(0)
+                a, d, wsum, bsum, n_in, dx, g_c, gf, gint_w, df, kap, np.empty(0), *_one_mode(bsum)
             )
             f = wsum[:n_in] - kap * (d - g_c[:n_in])
             # Rounding's own scale: the terms the deviations are differences of.
@@ -94,8 +100,9 @@ def test_the_sum_form_is_simpsons_integral_to_rounding(n: int, per_cell: int, on
             worst = max(worst, abs(summed - simpson) / scale)
             assert abs(summed - simpson) <= 16 * np.finfo(float).eps * scale, (trial, a, simpson, summed)
             for block in range(1, n_in - 3, max(1, (n_in - 4) // 3)):
-                after = _kernels._deviation_after(a, d, wsum, bsum, n_in, block, dx, g_c, gf, gint, df, kap)
-                fast = _kernels._deviation_after(a, d, wsum, bsum, n_in, block, dx, g_c, gf, gint_w, df, kap)
+                head = (a, d, wsum, bsum, n_in, block, dx, g_c, gf)
+                after = _kernels._deviation_after(*head, gint, df, kap, *_one_mode(bsum))
+                fast = _kernels._deviation_after(*head, gint_w, df, kap, *_one_mode(bsum))
                 assert abs(fast - after) <= 16 * np.finfo(float).eps * scale, (trial, a, block, after, fast)
     assert worst > 0.0  # the two forms are computed differently (not the same code twice)
 
@@ -119,5 +126,8 @@ def test_a_row_carries_its_force_weights() -> None:
     grown = row.regrid(dx=dx2, g_c=g_c2, gf=gf2, gint=gint2, df=df2, reach=np.inf, wl=np.zeros((2 * n, k)))
     assert np.array_equal(grown.gint_kernel, gint_w2)
     a = 0.6 * length
-    want = _kernels._force(a, 2e-6, row.wsum, row.bsum, dx, g_c, gf, gint_w, df, 1e6, row.kap, np.empty(0))
+    modes = row.kernel_args[18:22]  # p, p_inv, lam, beta
+    wb = row.kernel_args[2]
+    head = (a, 2e-6, row.wsum, row.bsum, dx, g_c, gf, gint_w, df)
+    want = _kernels._force(*head, 1e6, row.kap, np.empty(0), wb, *modes)
     assert _kernels.force(row, a, 2e-6) == want

@@ -55,7 +55,8 @@ def _counted_step(row: _kernels.Row, a: float, d0: float, d1: float, dt: float, 
     args = row.kernel_args
     wl, wsum, wb, bsum = args[0:4]
     dx, g_c, gf, gint, df, e0, kap = args[8], args[9], args[10], args[11], args[14], args[15], args[23]
-    force_prev = _kernels._force(a, d0, wsum, bsum, dx, g_c, gf, gint, df, e0, kap, np.empty(0))
+    modes = args[18:22]  # p, p_inv, lam, beta
+    force_prev = _kernels._force(a, d0, wsum, bsum, dx, g_c, gf, gint, df, e0, kap, np.empty(0), wb, *modes)
     _kernels._update_range = update_range
     _kernels._catch_up = catch_up
     try:
