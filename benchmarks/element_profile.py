@@ -52,6 +52,11 @@ def loop_advance_from(args, radius, depth, dt, ms, mm):
         args[15],
         args[23],
         args[6],
+        args[2],
+        args[18],
+        args[19],
+        args[20],
+        args[21],
     )
     for s in range(1, depth.shape[0]):
         K._advance_from(*args, radius, depth[s - 1], depth[s], dt, ms, mm, fp, args[0][:0], args[2][:0])
@@ -85,6 +90,11 @@ def loop_force(args, radius, depth):
             args[15],
             args[23],
             args[6],
+            args[2],
+            args[18],
+            args[19],
+            args[20],
+            args[21],
         )
     return t
 
