@@ -173,8 +173,7 @@ class ModelValidity:
     message: what fails, or "" when all hold; resolution_ok: the time-stepped grid resolves
     the contact (it spans at least `RESOLUTION_ELEMENTS` elements; always true out of
     contact, while the edge recedes, and on the closed-form path); elements_in_contact: contact
-    radius over the element
-    width (inf when there is no grid or no contact).
+    radius over the element width (inf when there is no grid or no contact).
     """
 
     edge_slope: float

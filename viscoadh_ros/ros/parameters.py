@@ -68,29 +68,20 @@ class _Spec:
 
 # Per-contact parameters, keyed by the name after ``<contact id>.``. Changing any of them
 # replaces the contact's simulator, which the node allows only while the contact is out of
-# touch and relaxed (checked at runtime, so not read_only).
+# touch and relaxed (checked at runtime, so not read_only). The indenter, material and adhesion
+# numbers take their ranges from the loader's `PHYSICAL_RANGES` (`descriptor`), not from here.
 _CONTACT_SPECS: dict[str, _Spec] = {
     "indenter.shape": _Spec("Indenter shape: sphere | cone | flat_punch | power_law | table."),
-    "indenter.radius": _Spec("Sphere radius or flat punch radius, m (> 0).", low=0.0, high=_INF),
-    "indenter.half_angle": _Spec(
-        "Cone half-angle between axis and flank, rad (0 < angle < pi/2).",
-        low=0.0,
-        high=math.pi / 2,
-    ),
-    "indenter.coefficient": _Spec(
-        "Power-law profile coefficient c in f = c r^n, m^(1-n) (> 0).",
-        low=0.0,
-        high=_INF,
-    ),
-    "indenter.exponent": _Spec("Power-law profile exponent n (> 0).", low=0.0, high=_INF),
+    "indenter.radius": _Spec("Sphere radius or flat punch radius, m (> 0)."),
+    "indenter.half_angle": _Spec("Cone half-angle between axis and flank, rad (0 < angle < pi/2)."),
+    "indenter.coefficient": _Spec("Power-law profile coefficient c in f = c r^n, m^(1-n) (> 0)."),
+    "indenter.exponent": _Spec("Power-law profile exponent n (> 0)."),
     "indenter.table_radius": _Spec("Tabulated profile: radii r, m (strictly increasing, from 0)."),
     "indenter.table_height": _Spec(
         "Tabulated profile: gap heights f(r), m (same length as table_radius, f(0) = 0)."
     ),
     "material.glass_shear_modulus": _Spec(
-        "Instantaneous (glass) shear modulus G0 of the body, Pa (> 0).",
-        low=0.0,
-        high=_INF,
+        "Instantaneous (glass) shear modulus G0 of the body, Pa (> 0)."
     ),
     "material.kelvin_shear_moduli": _Spec(
         "Shear moduli G_k of the Kelvin elements in series with the glass spring, Pa (> 0 each)."
@@ -99,24 +90,16 @@ _CONTACT_SPECS: dict[str, _Spec] = {
         "Viscosities eta_k of the Kelvin elements, Pa s (> 0 each, one per modulus)."
     ),
     "material.poisson_ratio": _Spec(
-        "Poisson ratio nu of the body; E* = 2 G / (1 - nu). Default 0.5 (incompressible).",
-        low=0.0,
-        high=0.5,
+        "Poisson ratio nu of the body; E* = 2 G / (1 - nu). Default 0.5 (incompressible)."
     ),
     "material.prony_long_term_modulus": _Spec(
-        "Relaxation Prony series: long-term shear modulus G_inf, Pa (converted exactly to the Kelvin chain).",
-        low=0.0,
-        high=_INF,
+        "Relaxation Prony series: long-term shear modulus G_inf, Pa (converted exactly to the Kelvin chain)."
     ),
     "material.prony_moduli": _Spec("Relaxation Prony series: moduli G_i, Pa (> 0 each)."),
     "material.prony_times": _Spec("Relaxation Prony series: relaxation times tau_i, s (> 0)."),
-    "adhesion.work_of_adhesion": _Spec(
-        "Work of adhesion dgamma, J/m^2 (>= 0; 0 = non-adhesive).", low=0.0, high=_INF
-    ),
+    "adhesion.work_of_adhesion": _Spec("Work of adhesion dgamma, J/m^2 (>= 0; 0 = non-adhesive)."),
     "adhesion.interaction_range": _Spec(
-        "Range h of the adhesive interaction, m (> 0); used for the scale-separation check.",
-        low=0.0,
-        high=_INF,
+        "Range h of the adhesive interaction, m (> 0); used for the scale-separation check."
     ),
     "numerics.preset": _Spec("Numerics preset: fast | balanced | accurate."),
     "numerics.model": _Spec(
@@ -298,14 +281,12 @@ def ros_parameter(name: str, value: Any) -> Parameter:
 def descriptor(name: str, parameter_type: int) -> ParameterDescriptor:
     """The ParameterDescriptor for a flat scene parameter: description, range, read_only."""
     spec = spec_for(name) or _Spec(f"Scene parameter {name} (see docs/ros_interface.md).")
+    low, high, description = spec.low, spec.high, spec.description
     _, _, leaf = name.partition(".")
-    physical = PHYSICAL_RANGES.get(leaf) if name not in _NODE_SPECS else None
-    description = spec.description
-    if physical is not None:
-        # The loader's range (both ends included), what a change is checked against; the
-        # spec's own low/high only say the sign ("> 0").
-        low, high, unit = physical
-        spec = _Spec(description, low=low, high=high, read_only=spec.read_only)
+    if name not in _NODE_SPECS and leaf in PHYSICAL_RANGES:
+        # An indenter, material or adhesion number: the loader's range (both ends included),
+        # the one a change is checked against.
+        low, high, unit = PHYSICAL_RANGES[leaf]
         description += f" Allowed: [{low:g}, {high:g}]" + (f" {unit}" if unit else "") + "."
     desc = ParameterDescriptor(
         name=name,
@@ -313,12 +294,12 @@ def descriptor(name: str, parameter_type: int) -> ParameterDescriptor:
         description=description,
         read_only=spec.read_only,
     )
-    if spec.low is not None and parameter_type == ParameterType.PARAMETER_DOUBLE:
+    if low is not None and parameter_type == ParameterType.PARAMETER_DOUBLE:
         desc.floating_point_range = [
-            FloatingPointRange(from_value=float(spec.low), to_value=float(spec.high), step=0.0)
+            FloatingPointRange(from_value=float(low), to_value=float(high), step=0.0)
         ]
-    elif spec.low is not None and parameter_type == ParameterType.PARAMETER_INTEGER:
-        desc.integer_range = [IntegerRange(from_value=int(spec.low), to_value=int(spec.high), step=0)]
+    elif low is not None and parameter_type == ParameterType.PARAMETER_INTEGER:
+        desc.integer_range = [IntegerRange(from_value=int(low), to_value=int(high), step=0)]
     return desc
 
 
