@@ -890,8 +890,15 @@ def _relaxed_share(b_prev, b_relaxed):
     blend, none at or below 0."""
     if b_relaxed <= 0.0:
         return 1.0
-    r = b_prev / b_relaxed
-    if r >= 1.0:
+    return _share_at(b_prev / b_relaxed, 1.0)
+
+
+@numba.njit(cache=True, nogil=True, _nrt=False, inline="always")
+def _share_at(r, relaxed_from):
+    """The blend's share for a unit memory at ``r`` of its relaxed level (one relaxation
+    time): 1 from ``relaxed_from`` on, 0 at or below 0, else ``max(0, 1 + CENTRE_CUT / ln(1 -
+    r))`` (see `_relaxed_share`). `_relaxed_share` and `_modal_share`'s modes read it."""
+    if r >= relaxed_from:
         return 1.0
     if r <= 0.0:
         return 0.0
@@ -926,16 +933,7 @@ def _modal_share(wb, prev, p, p_inv, lam, beta):
             col += p_inv[k, m]
         weight = abs(col * zb)
         relaxed = beta[m] / lam[m]
-        if relaxed == 0.0:
-            share = 1.0
-        else:
-            r = zb / relaxed
-            if r >= 1.0 - MODE_RELAXED:
-                share = 1.0
-            elif r <= 0.0:
-                share = 0.0
-            else:
-                share = max(0.0, 1.0 + CENTRE_CUT / math.log1p(-r))
+        share = 1.0 if relaxed == 0.0 else _share_at(zb / relaxed, 1.0 - MODE_RELAXED)
         num += weight * share
         den += weight
     if den <= 0.0:
