@@ -22,13 +22,12 @@ import yaml
 from rcl_interfaces.msg import Parameter as ParameterMsg
 from rcl_interfaces.msg import ParameterType, ParameterValue
 from rcl_interfaces.srv import SetParameters
-from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.parameter import Parameter
-from viscoadh_msgs.msg import ContactEvent, ContactState, IndentationCommand
+from viscoadh_msgs.msg import ContactEvent, IndentationCommand
 from viscoadh_msgs.srv import PredictPullOff
 
-from tests.test_node_process import SCENE, START_TIMEOUT, TIMEOUT, VISCOADH, run_node_process
+from tests.test_node_process import SCENE, START_TIMEOUT, TIMEOUT, VISCOADH, Controller, run_node_process
 from viscoadh_ros.core.config import SceneConfig
 from viscoadh_ros.core.simulator import ContactSimulator
 from viscoadh_ros.ros.conversions import ns_to_stamp
@@ -55,32 +54,15 @@ def node_process(tmp_path: Path, ros_env: dict[str, str]) -> Any:
 def test_a_bad_runtime_change_is_refused_and_the_node_keeps_serving(
     node_process: Any, ros_localhost_context: Any, spin_until: Any, tmp_path: Path
 ) -> None:
-    executor = SingleThreadedExecutor(context=ros_localhost_context)
-    client = Node("controller", context=ros_localhost_context)
-    executor.add_node(client)
-    states: list[ContactState] = []
+    log = tmp_path / "node.log"
+    controller = Controller(ros_localhost_context, spin_until, node_process, log)
+    client, pub, states, call = controller.node, controller.pub, controller.states, controller.call
     events: list[ContactEvent] = []
-    pub = client.create_publisher(IndentationCommand, "finger/indentation", 10)
-    client.create_subscription(ContactState, "finger/state", states.append, 100)
     # C/events is transient local, keep last 10 (docs/ros_interface.md): late joiners see them.
     from viscoadh_ros.ros.node import EVENTS_QOS
 
     client.create_subscription(ContactEvent, "finger/events", events.append, EVENTS_QOS)
-    log = tmp_path / "node.log"
-    up = spin_until(
-        executor,
-        lambda: (pub.get_subscription_count() > 0 and bool(states)) or node_process.poll() is not None,
-        START_TIMEOUT,
-    )
-    assert up and node_process.poll() is None, log.read_text()
-
-    def call(srv_type: Any, name: str, request: Any) -> Any:
-        service = client.create_client(srv_type, name)
-        assert service.wait_for_service(timeout_sec=TIMEOUT), f"{name} not available\n{log.read_text()}"
-        future = service.call_async(request)
-        executor.spin_until_future_complete(future, timeout_sec=TIMEOUT)
-        assert future.done(), f"{name} did not answer\n{log.read_text()}"
-        return future.result()
+    executor = controller.executor
 
     def set_one(parameter: ParameterMsg) -> Any:
         return call(
@@ -123,9 +105,7 @@ def test_a_bad_runtime_change_is_refused_and_the_node_keeps_serving(
     assert set_one(_double("command.max_future_s", 20.0)).successful
     assert node_process.poll() is None
 
-    executor.remove_node(client)
-    client.destroy_node()
-    executor.shutdown(timeout_sec=1.0)
+    controller.close()
     node_process.send_signal(signal.SIGINT)
     assert node_process.wait(timeout=10.0) == 0, log.read_text()
 

@@ -79,28 +79,58 @@ def node_process(tmp_path: Path, ros_env: dict[str, str]) -> Any:
     yield from run_node_process(tmp_path, ros_env)
 
 
+class Controller:
+    """The controller side of a node process's test: a client node on its own executor with a
+    command publisher and the contact's states, up once the node answers (its idle heartbeat),
+    calling services with the node's log in every failure message."""
+
+    def __init__(self, context: Any, spin_until: Any, process: Any, log: Path, contact: str = "finger"):
+        self.log = log
+        self.executor = SingleThreadedExecutor(context=context)
+        self.node = Node("controller", context=context)
+        self.executor.add_node(self.node)
+        self.states: list[ContactState] = []
+        self.pub = self.node.create_publisher(IndentationCommand, f"{contact}/indentation", 10)
+        self.node.create_subscription(ContactState, f"{contact}/state", self.states.append, 100)
+        up = spin_until(
+            self.executor,
+            lambda: (
+                (self.pub.get_subscription_count() > 0 and self.node.count_publishers(f"{contact}/state") > 0)
+                or process.poll() is not None
+            ),
+            START_TIMEOUT,
+        )
+        assert up and process.poll() is None, log.read_text()
+        # The node's state publisher may not have matched our subscription yet (discovery is not
+        # symmetric; a reliable volatile writer drops what it published before): its idle
+        # heartbeat (once per second) arriving proves it has.
+        assert spin_until(self.executor, lambda: bool(self.states), START_TIMEOUT), "no idle heartbeat state"
+
+    def call(self, srv_type: Any, name: str, request: Any) -> Any:
+        service = self.node.create_client(srv_type, name)
+        assert service.wait_for_service(timeout_sec=TIMEOUT), f"{name} not available\n{self.log.read_text()}"
+        future = service.call_async(request)
+        self.executor.spin_until_future_complete(future, timeout_sec=TIMEOUT)
+        assert future.done(), f"{name} did not answer\n{self.log.read_text()}"
+        return future.result()
+
+    def close(self) -> None:
+        self.executor.remove_node(self.node)
+        self.node.destroy_node()
+        self.executor.shutdown(timeout_sec=1.0)
+
+
 def test_node_process_serves_a_controller_like_the_core(
     node_process: Any, ros_localhost_context: Any, spin_until: Any, tmp_path: Path
 ) -> None:
-    executor = SingleThreadedExecutor(context=ros_localhost_context)
-    client = Node("controller", context=ros_localhost_context)
-    executor.add_node(client)
-    states: list[ContactState] = []
-    pub = client.create_publisher(IndentationCommand, "finger/indentation", 10)
-    client.create_subscription(ContactState, "finger/state", states.append, 100)
-    up = spin_until(
-        executor,
-        lambda: (
-            (pub.get_subscription_count() > 0 and client.count_publishers("finger/state") > 0)
-            or node_process.poll() is not None
-        ),
-        START_TIMEOUT,
+    controller = Controller(ros_localhost_context, spin_until, node_process, tmp_path / "node.log")
+    executor, client, pub, states, call = (
+        controller.executor,
+        controller.node,
+        controller.pub,
+        controller.states,
+        controller.call,
     )
-    assert up and node_process.poll() is None, (tmp_path / "node.log").read_text()
-    # The node's state publisher may not have matched our subscription yet (discovery is not
-    # symmetric; a reliable volatile writer drops what it published before): its idle heartbeat
-    # (once per second) arriving proves it has.
-    assert spin_until(executor, lambda: bool(states), START_TIMEOUT), "no idle heartbeat state"
 
     # Slow approach and retract, stamped 10 s ahead of the clock (see test_node_live).
     time = np.arange(0.0, 0.6, 0.01)
@@ -118,14 +148,6 @@ def test_node_process_serves_a_controller_like_the_core(
             + (tmp_path / "node.log").read_text()
         )
         forces.append(states[-1].force)
-
-    def call(srv_type: Any, name: str, request: Any) -> Any:
-        service = client.create_client(srv_type, name)
-        assert service.wait_for_service(timeout_sec=TIMEOUT), f"{name} not available"
-        future = service.call_async(request)
-        executor.spin_until_future_complete(future, timeout_sec=TIMEOUT)
-        assert future.done(), f"{name} did not answer"
-        return future.result()
 
     history = call(
         SimulateHistory,
@@ -155,9 +177,7 @@ def test_node_process_serves_a_controller_like_the_core(
     assert prediction.success, prediction.message
     assert prediction.pull_off_force < 0.0, "adhesive contact pulls off under tension"
 
-    executor.remove_node(client)
-    client.destroy_node()
-    executor.shutdown(timeout_sec=1.0)
+    controller.close()
     node_process.send_signal(signal.SIGINT)
     assert node_process.wait(timeout=10.0) == 0, (tmp_path / "node.log").read_text()
 
