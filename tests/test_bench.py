@@ -134,47 +134,11 @@ def test_the_timed_parts_do_the_kernels_work(kelvin: int) -> None:
     want = row.memory()
     assert np.array_equal(got[0], want[0]) and np.array_equal(got[1], want[1])
     buf = np.empty(row.elements)
-    force = sum(
-        _kernels._force(
-            radius,
-            d,
-            row.wsum,
-            row.bsum,
-            row.dx,
-            row.g_c,
-            row.gf,
-            row.gint,
-            row.df,
-            row.e0,
-            row.kap,
-            buf,
-            row.wb,
-            row.p,
-            row.p_inv,
-            row.lam,
-            row.beta,
-        )
-        for d in depth[1:]
-    )
-    assert kernel._force_parts(
-        radius,
-        depth,
-        row.wsum,
-        row.bsum,
-        row.dx,
-        row.g_c,
-        row.gf,
-        row.gint,
-        row.df,
-        row.e0,
-        row.kap,
-        buf,
-        row.wb,
-        row.p,
-        row.p_inv,
-        row.lam,
-        row.beta,
-    ) == pytest.approx(force, rel=1e-14)
+    # What both take after the radius and the depth(s): the row's memory, grid and modes.
+    rest = (row.wsum, row.bsum, row.dx, row.g_c, row.gf, row.gint, row.df, row.e0, row.kap, buf)
+    rest += (row.wb, row.p, row.p_inv, row.lam, row.beta)
+    force = sum(_kernels._force(radius, d, *rest) for d in depth[1:])
+    assert kernel._force_parts(radius, depth, *rest) == pytest.approx(force, rel=1e-14)
     edges = sum(
         _kernels._locate_edge(
             radius, d, row.wsum, row.bsum, row.dx, row.g_c, row.gf, row.gmin, row.gmax, row.df, row.c_crit,
